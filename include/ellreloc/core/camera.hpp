@@ -1,0 +1,99 @@
+#pragma once
+/// \file camera.hpp
+/// Pinhole intrinsics and world->camera poses (x_c = R_cw x_w + t_cw, as ORB-SLAM's Tcw).
+
+#include "ellreloc/core/ellipsoid.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cmath>
+
+namespace ellreloc {
+
+/// Pinhole intrinsics of an undistorted image of width x height pixels.
+struct Intrinsics {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  int width = 0, height = 0;
+
+  Intrinsics() = default;
+  Intrinsics(double fx_, double fy_, double cx_, double cy_, int width_, int height_)
+      : fx(fx_), fy(fy_), cx(cx_), cy(cy_), width(width_), height(height_) {}
+
+  /// Finite, positive focal lengths and a positive image size.
+  bool isValid() const {
+    return std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) && std::isfinite(cy) && fx > 0 &&
+           fy > 0 && width > 0 && height > 0;
+  }
+
+  Eigen::Matrix3d K() const {
+    Eigen::Matrix3d k;
+    k << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+    return k;
+  }
+
+  /// Pixel of a point in camera coordinates (z must be > 0).
+  Eigen::Vector2d project(const Eigen::Vector3d& x_c) const {
+    return {fx * x_c(0) / x_c(2) + cx, fy * x_c(1) / x_c(2) + cy};
+  }
+
+  /// Unit bearing vector of a pixel.
+  Eigen::Vector3d bearing(const Eigen::Vector2d& uv) const {
+    return Eigen::Vector3d((uv(0) - cx) / fx, (uv(1) - cy) / fy, 1.0).normalized();
+  }
+};
+
+/// World->camera rigid transform: x_c = R_cw x_w + t_cw.
+class Pose {
+ public:
+  Pose() = default;
+  Pose(const Eigen::Matrix3d& R_cw, const Eigen::Vector3d& t_cw) : R_(R_cw), t_(t_cw) {}
+
+  /// From a camera->world pose (camera centre and orientation in the world), as TUM
+  /// trajectory files store it.
+  static Pose fromCameraToWorld(const Eigen::Matrix3d& R_wc, const Eigen::Vector3d& center) {
+    return Pose(R_wc.transpose(), -R_wc.transpose() * center);
+  }
+
+  const Eigen::Matrix3d& rotation() const { return R_; }
+  const Eigen::Vector3d& translation() const { return t_; }
+
+  /// Camera centre in world coordinates: -R^T t.
+  Eigen::Vector3d center() const { return -R_.transpose() * t_; }
+
+  /// World point -> camera coordinates.
+  Eigen::Vector3d transform(const Eigen::Vector3d& x_w) const { return R_ * x_w + t_; }
+
+  /// The camera->world transform as a Pose object (its "rotation" is R_wc).
+  Pose inverse() const { return Pose(R_.transpose(), -R_.transpose() * t_); }
+
+  /// (this * other)(x) = this(other(x)).
+  Pose operator*(const Pose& other) const { return Pose(R_ * other.R_, R_ * other.t_ + t_); }
+
+  Eigen::Matrix<double, 3, 4> matrix3x4() const {
+    Eigen::Matrix<double, 3, 4> M;
+    M << R_, t_;
+    return M;
+  }
+
+  bool isValid() const { return t_.allFinite() && isRotation(R_); }
+
+ private:
+  Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t_ = Eigen::Vector3d::Zero();
+};
+
+/// Projection matrix P = K [R_cw | t_cw].
+inline Eigen::Matrix<double, 3, 4> projectionMatrix(const Intrinsics& K, const Pose& pose) {
+  return K.K() * pose.matrix3x4();
+}
+
+/// Rotation angle of R_a^T R_b in degrees (the rotation error of FORMATS.md).
+/// Computed through a quaternion (2 atan2), which stays accurate for tiny angles where
+/// acos((trace - 1) / 2) does not.
+inline double rotationErrorDeg(const Eigen::Matrix3d& Ra, const Eigen::Matrix3d& Rb) {
+  const Eigen::Quaterniond q(Eigen::Matrix3d(Ra.transpose() * Rb));
+  return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())) * 180.0 / M_PI;
+}
+
+}  // namespace ellreloc

@@ -1,0 +1,195 @@
+#pragma once
+/// \file distances.hpp
+/// Distances and overlaps between image ellipses. Formulas and their derivations are in
+/// docs/distances.md. Invalid ellipses (see Ellipse::isValid) give +infinity for distances and
+/// 0 for overlaps, never NaN.
+
+#include "ellreloc/core/ellipse.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace ellreloc {
+
+/// Squared Wasserstein-2 distance between the Gaussians N(m1, S1) and N(m2, S2) in closed form
+/// for 2x2 covariances, without a matrix square root:
+///   W2^2 = |m1 - m2|^2 + tr S1 + tr S2 - 2 sqrt(tr(S1 S2) + 2 sqrt(det S1 det S2)).
+/// The covariance part is evaluated as
+///   (|S1 - S2|_F^2 + 2 det(S1 + S2) - 8 sqrt(det S1 det S2)) / (tr S1 + tr S2 + 2 s),
+/// which is algebraically equal but has no cancellation for nearly equal ellipses and is
+/// exactly 0 for equal ones. Templated for Ceres.
+template <typename T>
+T wasserstein2Squared(const Vec2<T>& m1, const Mat2<T>& S1, const Vec2<T>& m2, const Mat2<T>& S2) {
+  using std::sqrt;
+  const T det1 = S1(0, 0) * S1(1, 1) - S1(0, 1) * S1(1, 0);
+  const T det2 = S2(0, 0) * S2(1, 1) - S2(0, 1) * S2(1, 0);
+  const Mat2<T> sum = S1 + S2;
+  const T det_sum = sum(0, 0) * sum(1, 1) - sum(0, 1) * sum(1, 0);
+  const T tr_prod = S1(0, 0) * S2(0, 0) + S1(0, 1) * S2(1, 0) + S1(1, 0) * S2(0, 1) + S1(1, 1) * S2(1, 1);
+  // Rounding can make the determinant of a very thin ellipse slightly negative: clamp.
+  const T det_prod = det1 * det2;
+  const T root_det = det_prod > T(0) ? sqrt(det_prod) : T(0);
+  const T s2 = tr_prod + T(2) * root_det;
+  const T s = s2 > T(0) ? sqrt(s2) : T(0);
+  const T denom = S1(0, 0) + S1(1, 1) + S2(0, 0) + S2(1, 1) + T(2) * s;
+  T numer = (S1 - S2).squaredNorm() + T(2) * det_sum - T(8) * root_det;
+  if (numer < T(0)) numer = T(0);  // rounding only: the exact value is >= 0
+  const T cov_term = denom > T(0) ? numer / denom : T(0);
+  return (m1 - m2).squaredNorm() + cov_term;
+}
+
+inline double wasserstein2Squared(const Ellipse& a, const Ellipse& b) {
+  if (!a.isValid() || !b.isValid()) return std::numeric_limits<double>::infinity();
+  return wasserstein2Squared<double>(a.center(), a.covariance(), b.center(), b.covariance());
+}
+
+/// Wasserstein-2 distance in pixels.
+inline double wasserstein2(const Ellipse& a, const Ellipse& b) { return std::sqrt(wasserstein2Squared(a, b)); }
+
+/// Bhattacharyya distance between the ellipses' Gaussians:
+///   1/8 d^T S^-1 d + 1/2 ln(det S / sqrt(det S1 det S2)),  S = (S1 + S2) / 2, d = m1 - m2.
+inline double bhattacharyya(const Ellipse& a, const Ellipse& b) {
+  if (!a.isValid() || !b.isValid()) return std::numeric_limits<double>::infinity();
+  const Eigen::Matrix2d S = 0.5 * (a.covariance() + b.covariance());
+  const Eigen::Vector2d d = a.center() - b.center();
+  // det S1 = (a1 b1)^2 exactly, which avoids cancellation for thin ellipses.
+  const double ln_det1 = 2.0 * std::log(a.axes()(0) * a.axes()(1));
+  const double ln_det2 = 2.0 * std::log(b.axes()(0) * b.axes()(1));
+  const double det = S.determinant();
+  if (!(det > 0.0)) return std::numeric_limits<double>::infinity();
+  const double result = 0.125 * d.dot(S.inverse() * d) + 0.5 * (std::log(det) - 0.5 * (ln_det1 + ln_det2));
+  return std::max(0.0, result);
+}
+
+namespace detail {
+
+/// Signed area of (triangle origin, p, q) intersected with the unit disc.
+inline double triangleDiscArea(const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
+  const double cross_pq = p(0) * q(1) - p(1) * q(0);
+  if (p.squaredNorm() <= 1.0 && q.squaredNorm() <= 1.0) return 0.5 * cross_pq;  // disc is convex
+  const Eigen::Vector2d d = q - p;
+  // |p + t d|^2 = 1  ->  (d.d) t^2 + 2 (p.d) t + (p.p - 1) = 0
+  const double A = d.squaredNorm(), B = p.dot(d), C = p.squaredNorm() - 1.0;
+  double cuts[4] = {0.0, 0.0, 0.0, 1.0};
+  int n = 1;
+  const double disc = B * B - A * C;
+  if (A > 0.0 && disc > 0.0) {
+    const double r = std::sqrt(disc);
+    const double t1 = (-B - r) / A, t2 = (-B + r) / A;
+    if (t1 > 0.0 && t1 < 1.0) cuts[n++] = t1;
+    if (t2 > 0.0 && t2 < 1.0) cuts[n++] = t2;
+  }
+  cuts[n++] = 1.0;
+  double area = 0.0;
+  for (int i = 0; i + 1 < n; ++i) {
+    const Eigen::Vector2d a = p + cuts[i] * d, b = p + cuts[i + 1] * d;
+    const Eigen::Vector2d mid = 0.5 * (a + b);
+    const double cross = a(0) * b(1) - a(1) * b(0);
+    if (mid.squaredNorm() <= 1.0)
+      area += 0.5 * cross;  // piece inside the disc: a plain triangle
+    else
+      area += 0.5 * std::atan2(cross, a.dot(b));  // outside: a circular sector
+  }
+  return area;
+}
+
+}  // namespace detail
+
+/// Intersection over union of two ellipses.
+///
+/// IoU is invariant under affine maps, so the first ellipse is mapped to the unit disc and
+/// the second, approximated by a polygon of `vertices` vertices whose area equals the
+/// ellipse's, is intersected exactly with the disc (sum of signed triangle-disc areas).
+/// The only approximation is that polygon: with the default 128 vertices the absolute IoU
+/// error is below 1e-3 (tested against rasterisation). 0 for invalid input.
+inline double ellipseIoU(const Ellipse& e1, const Ellipse& e2, int vertices = 128) {
+  if (!e1.isValid() || !e2.isValid() || vertices < 3) return 0.0;
+  const Box b1 = e1.boundingBox(), b2 = e2.boundingBox();
+  if (b1.x2 <= b2.x1 || b2.x2 <= b1.x1 || b1.y2 <= b2.y1 || b2.y2 <= b1.y1) return 0.0;
+  // Make the larger ellipse the disc: the polygon error then scales with the smaller area.
+  const bool swap = e1.area() < e2.area();
+  const Ellipse& big = swap ? e2 : e1;
+  const Ellipse& small = swap ? e1 : e2;
+  // x' = diag(1/a, 1/b) R^T (x - c) maps `big` onto the unit disc.
+  const Eigen::Matrix2d to_disc = big.axes().cwiseInverse().asDiagonal() * big.rotation().transpose();
+  const Eigen::Matrix2d small_shape = small.rotation() * small.axes().asDiagonal();
+  // Polygon radius scaled so its area is the ellipse's: (n/2) sin(2 pi/n) k^2 = pi.
+  const double step = 2.0 * M_PI / vertices;
+  const double k = std::sqrt(M_PI / (0.5 * vertices * std::sin(step)));
+  const Eigen::Vector2d offset = to_disc * (small.center() - big.center());
+  const Eigen::Matrix2d shape = k * to_disc * small_shape;
+  // Unit-circle points by repeated rotation: no sin/cos per vertex (drift ~1e-15 over n steps).
+  const double cs = std::cos(step), sn = std::sin(step);
+  Eigen::Vector2d unit(1.0, 0.0);
+  const Eigen::Vector2d first = offset + shape * unit;
+  Eigen::Vector2d prev = first;
+  double inter_disc = 0.0;  // intersection area in the disc frame
+  for (int i = 1; i <= vertices; ++i) {
+    unit = Eigen::Vector2d(cs * unit(0) - sn * unit(1), sn * unit(0) + cs * unit(1));
+    const Eigen::Vector2d cur = i == vertices ? first : Eigen::Vector2d(offset + shape * unit);
+    inter_disc += detail::triangleDiscArea(prev, cur);
+    prev = cur;
+  }
+  // Both maps have a positive determinant, so the polygon stays counter-clockwise.
+  const double inter = std::min(std::abs(inter_disc) * big.axes().prod(), small.area());
+  const double uni = e1.area() + e2.area() - inter;
+  return uni > 0.0 ? std::clamp(inter / uni, 0.0, 1.0) : 0.0;
+}
+
+/// Level-set distance between two ellipses, after Zins et al. (IROS 2022, "Level set-based
+/// camera pose estimation from multiple 2D/3D ellipse-ellipsoid correspondences"): points are
+/// sampled on the level sets rho_a = s (s in {1/2, 1, 3/2}) of each ellipse's Mahalanobis
+/// radius rho, and compared with the other ellipse's radius at the same points:
+///   d = sqrt( mean over both directions and all samples of (rho_b(x) - s)^2 ).
+/// Dimensionless; 0 for equal ellipses (up to rounding); smooth in both ellipses' parameters.
+/// `samples_per_level` points per level set and direction (default 16). Templated for Ceres.
+template <typename T>
+T levelSetDistance(const Vec2<T>& c1, const Mat2<T>& S1, const Vec2<T>& c2, const Mat2<T>& S2,
+                   int samples_per_level = 16) {
+  using std::sqrt;
+  // Mahalanobis radius needs S^-1; the level-set points need a square root factor L with
+  // L L^T = S (Cholesky of a 2x2 SPD matrix).
+  auto inv = [](const Mat2<T>& S) {
+    const T det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+    Mat2<T> I;
+    I << S(1, 1) / det, -S(0, 1) / det, -S(1, 0) / det, S(0, 0) / det;
+    return I;
+  };
+  auto chol = [](const Mat2<T>& S) {
+    Mat2<T> L = Mat2<T>::Zero();
+    L(0, 0) = sqrt(S(0, 0));
+    L(1, 0) = S(1, 0) / L(0, 0);
+    L(1, 1) = sqrt(S(1, 1) - L(1, 0) * L(1, 0));
+    return L;
+  };
+  const Mat2<T> L1 = chol(S1), L2 = chol(S2), I1 = inv(S1), I2 = inv(S2);
+  const double levels[3] = {0.5, 1.0, 1.5};
+  T sum = T(0);
+  int count = 0;
+  for (double s : levels) {
+    for (int i = 0; i < samples_per_level; ++i) {
+      const double t = 2.0 * M_PI * (i + 0.5) / samples_per_level;
+      const Vec2<T> u(T(s * std::cos(t)), T(s * std::sin(t)));
+      const Vec2<T> x1 = c1 + L1 * u;  // on level s of ellipse 1
+      const Vec2<T> x2 = c2 + L2 * u;  // on level s of ellipse 2
+      const Vec2<T> d1 = x1 - c2, d2 = x2 - c1;
+      const T q1 = d1.dot(I2 * d1), q2 = d2.dot(I1 * d2);
+      // sqrt(q) - s written as (q - s^2) / (sqrt(q) + s): no infinite derivative at q = 0.
+      const T r1 = (q1 - T(s * s)) / (sqrt(q1 > T(0) ? q1 : T(0)) + T(s));
+      const T r2 = (q2 - T(s * s)) / (sqrt(q2 > T(0) ? q2 : T(0)) + T(s));
+      sum += r1 * r1 + r2 * r2;
+      count += 2;
+    }
+  }
+  return sqrt(sum / T(count));
+}
+
+inline double levelSetDistance(const Ellipse& a, const Ellipse& b, int samples_per_level = 16) {
+  if (!a.isValid() || !b.isValid() || samples_per_level < 1) return std::numeric_limits<double>::infinity();
+  return levelSetDistance<double>(a.center(), a.covariance(), b.center(), b.covariance(), samples_per_level);
+}
+
+}  // namespace ellreloc

@@ -1,0 +1,29 @@
+#pragma once
+/// \file trajectory.hpp
+/// TUM trajectories (`timestamp tx ty tz qx qy qz qw`, camera->world on disk; world->camera
+/// Pose in memory) and TUM association files.
+
+#include "ellreloc/core/camera.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ellreloc::io {
+
+struct StampedPose {
+  double timestamp = 0.0;
+  Pose pose;  ///< world->camera
+};
+
+/// Reads a TUM trajectory; `#` starts a comment. Quaternions are normalised; a zero or
+/// non-finite one is an error naming the line. Throws ellreloc::Error on malformed input.
+std::vector<StampedPose> readTumTrajectory(const std::string& path);
+
+/// Writes camera->world lines with full precision, atomically.
+void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses);
+
+/// Index of the pose whose timestamp is nearest to t, if within `tolerance` seconds.
+std::optional<size_t> findNearest(const std::vector<StampedPose>& poses, double t, double tolerance = 0.02);
+
+}  // namespace ellreloc::io

@@ -1,0 +1,75 @@
+#pragma once
+/// \file rle.hpp
+/// COCO run-length masks, bit-exact with pycocotools: runs over the pixels in column-major
+/// order (x outer, y inner), starting with a run of zeros; the compressed string form codes
+/// each run (from the fourth on, minus the run two before) in 5-bit groups, 0x20 = "more",
+/// offset by 48 (pycocotools' rleToString / rleFrString).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ellreloc {
+
+struct RleMask {
+  int height = 0;
+  int width = 0;
+  std::vector<uint32_t> counts;  ///< alternating runs of 0s and 1s, starting with 0s
+
+  /// Sum of the runs; equals height * width for a consistent mask.
+  uint64_t totalPixels() const {
+    uint64_t n = 0;
+    for (uint32_t c : counts) n += c;
+    return n;
+  }
+  bool isConsistent() const {
+    return height > 0 && width > 0 && totalPixels() == static_cast<uint64_t>(height) * static_cast<uint64_t>(width);
+  }
+};
+
+/// Encodes run lengths as pycocotools' compressed string.
+inline std::string encodeRleString(const std::vector<uint32_t>& counts) {
+  std::string s;
+  for (size_t i = 0; i < counts.size(); ++i) {
+    long long x = counts[i];
+    if (i > 2) x -= static_cast<long long>(counts[i - 2]);
+    bool more = true;
+    while (more) {
+      char c = static_cast<char>(x & 0x1f);
+      x >>= 5;  // arithmetic shift keeps the sign
+      more = (c & 0x10) ? x != -1 : x != 0;
+      if (more) c |= 0x20;
+      s.push_back(static_cast<char>(c + 48));
+    }
+  }
+  return s;
+}
+
+/// Decodes pycocotools' compressed string. nullopt when the string is malformed (a byte
+/// outside the alphabet, a truncated group, or a run that comes out negative).
+inline std::optional<std::vector<uint32_t>> decodeRleString(const std::string& s) {
+  std::vector<uint32_t> counts;
+  size_t p = 0;
+  while (p < s.size()) {
+    long long x = 0;
+    int k = 0;
+    bool more = true;
+    while (more) {
+      if (p >= s.size() || k > 12) return std::nullopt;  // truncated or absurdly long group
+      const int c = static_cast<unsigned char>(s[p]) - 48;
+      if (c < 0 || c > 63) return std::nullopt;
+      x |= static_cast<long long>(c & 0x1f) << (5 * k);
+      more = (c & 0x20) != 0;
+      ++p;
+      ++k;
+      if (!more && (c & 0x10)) x |= -(1LL << (5 * k));  // sign-extend
+    }
+    if (counts.size() > 2) x += counts[counts.size() - 2];
+    if (x < 0 || x > 0xffffffffLL) return std::nullopt;
+    counts.push_back(static_cast<uint32_t>(x));
+  }
+  return counts;
+}
+
+}  // namespace ellreloc

@@ -1,0 +1,140 @@
+#include "ellreloc/io/map.hpp"
+
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/files.hpp"
+#include "json_fields.hpp"
+
+#include <sstream>
+
+namespace ellreloc::io {
+
+namespace {
+
+using detail::json;
+using detail::Where;
+
+/// Rotations in files are rounded (float32 in OA-SLAM and GOReloc maps): accept them within
+/// this tolerance and return the nearest exact rotation.
+constexpr double kRotationTolerance = 1e-3;
+
+Ellipsoid ellipsoidFromDualQuadric(const Eigen::Matrix4d& Q, const Where& where) {
+  const auto e = Ellipsoid::fromDualQuadric(Q);
+  if (!e) where.fail("does not describe a real ellipsoid");
+  return *e;
+}
+
+Ellipsoid parseObjectGeometry(const json& obj, const Where& where) {
+  if (obj.contains("center") || !obj.contains("dual_quadric")) {
+    const Eigen::Vector3d c = detail::vector<3>(detail::member(obj, "center", where), where["center"]);
+    const Eigen::Vector3d axes = detail::vector<3>(detail::member(obj, "axes", where), where["axes"]);
+    if (axes.minCoeff() <= 0.0) where["axes"].fail("semi-axes must be positive");
+    const json& rot = detail::member(obj, "rotation", where);
+    if (!rot.is_array() || rot.size() != 3) where["rotation"].fail("expected 3 rows of 3 numbers");
+    Eigen::Matrix3d R;
+    for (size_t r = 0; r < 3; ++r) R.row(static_cast<int>(r)) = detail::vector<3>(rot[r], where["rotation"][r]).transpose();
+    if (!isRotation(R, kRotationTolerance)) where["rotation"].fail("not a rotation matrix (orthonormal, det +1)");
+    return Ellipsoid(c, axes, nearestRotation(R));
+  }
+  const json& q = obj["dual_quadric"];
+  if (!q.is_array() || q.size() != 16) where["dual_quadric"].fail("expected 16 numbers (row-major)");
+  Eigen::Matrix4d Q;
+  for (size_t i = 0; i < 16; ++i) Q(static_cast<int>(i / 4), static_cast<int>(i % 4)) = detail::finiteNumber(q[i], where["dual_quadric"][i]);
+  return ellipsoidFromDualQuadric(Q, where["dual_quadric"]);
+}
+
+}  // namespace
+
+ObjectMap parseMapJson(const std::string& text, const std::string& source) {
+  const json j = detail::parseJson(text, source);
+  const Where top{source, ""};
+  if (!j.is_object()) top.fail("expected a JSON object with \"objects\"");
+  if (j.contains("ellreloc_map")) {
+    const int version = detail::integer(j["ellreloc_map"], top["ellreloc_map"]);
+    if (version != 1) top["ellreloc_map"].fail("unsupported version " + std::to_string(version) + " (this reader knows 1)");
+  }
+  const json& objects = detail::member(j, "objects", top);
+  if (!objects.is_array()) top["objects"].fail("expected an array");
+  ObjectMap map;
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const Where where = top["objects"][i];
+    const json& o = objects[i];
+    if (!o.is_object()) where.fail("expected an object");
+    MapObject obj;
+    obj.id = detail::integer(detail::member(o, "id", where), where["id"]);
+    obj.category = detail::integer(detail::member(o, "category", where), where["category"]);
+    if (o.contains("label")) {
+      if (!o["label"].is_string()) where["label"].fail("expected a string");
+      obj.label = o["label"].get<std::string>();
+    }
+    obj.ellipsoid = parseObjectGeometry(o, where);
+    map.objects.push_back(std::move(obj));
+  }
+  if (j.contains("points")) {
+    const json& points = j["points"];
+    if (!points.is_array()) top["points"].fail("expected an array of [x, y, z]");
+    map.points.reserve(points.size());
+    for (size_t i = 0; i < points.size(); ++i) map.points.push_back(detail::vector<3>(points[i], top["points"][i]));
+  }
+  return map;
+}
+
+ObjectMap parseOaSlamMap(const std::string& text, const std::string& source) {
+  ObjectMap map;
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t\r")] == '#') continue;
+    const Where where{source, "line " + std::to_string(line_no)};
+    std::istringstream fields(line);
+    long long id = 0, category = 0;
+    if (!(fields >> id >> category)) where.fail("expected 'track_id category_id' then 16 numbers");
+    Eigen::Matrix4d Q;
+    for (int k = 0; k < 16; ++k) {
+      double v = 0;
+      if (!(fields >> v)) where.fail("expected 16 dual-quadric entries, found " + std::to_string(k));
+      if (!std::isfinite(v)) where.fail("dual-quadric entry " + std::to_string(k) + " is not finite");
+      Q(k % 4, k / 4) = v;  // column-major
+    }
+    std::string extra;
+    if (fields >> extra) where.fail("unexpected trailing text '" + extra + "'");
+    MapObject obj;
+    obj.id = static_cast<int>(id);
+    obj.category = static_cast<int>(category);
+    obj.ellipsoid = ellipsoidFromDualQuadric(Q, where);
+    map.objects.push_back(std::move(obj));
+  }
+  if (map.objects.empty()) throw Error(source + ": no objects found (empty or blank map file)");
+  return map;
+}
+
+ObjectMap readMap(const std::string& path) {
+  const std::string text = readTextFile(path);
+  const size_t first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) throw Error(path + ": empty file, expected a map");
+  return text[first] == '{' ? parseMapJson(text, path) : parseOaSlamMap(text, path);
+}
+
+void writeMap(const std::string& path, const ObjectMap& map) {
+  json objects = json::array();
+  for (const MapObject& o : map.objects) {
+    if (!o.ellipsoid.isValid()) throw Error(path + ": object " + std::to_string(o.id) + " has an invalid ellipsoid");
+    const Eigen::Matrix3d& R = o.ellipsoid.rotation();
+    json obj = {{"id", o.id}, {"category", o.category}};
+    if (!o.label.empty()) obj["label"] = o.label;
+    obj["center"] = {o.ellipsoid.center()(0), o.ellipsoid.center()(1), o.ellipsoid.center()(2)};
+    obj["axes"] = {o.ellipsoid.axes()(0), o.ellipsoid.axes()(1), o.ellipsoid.axes()(2)};
+    obj["rotation"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
+    objects.push_back(std::move(obj));
+  }
+  json j = {{"ellreloc_map", 1}, {"objects", std::move(objects)}};
+  if (!map.points.empty()) {
+    json points = json::array();
+    for (const auto& p : map.points) points.push_back({p(0), p(1), p(2)});
+    j["points"] = std::move(points);
+  }
+  writeFileAtomically(path, j.dump(1) + "\n");
+}
+
+}  // namespace ellreloc::io

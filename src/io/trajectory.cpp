@@ -1,0 +1,66 @@
+#include "ellreloc/io/trajectory.hpp"
+
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/files.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace ellreloc::io {
+
+std::vector<StampedPose> readTumTrajectory(const std::string& path) {
+  const std::string text = readTextFile(path);
+  std::istringstream in(text);
+  std::string line;
+  std::vector<StampedPose> poses;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::string where = path + ": line " + std::to_string(line_no) + ": ";
+    std::istringstream fields(line);
+    double v[8];
+    for (int k = 0; k < 8; ++k) {
+      if (!(fields >> v[k])) throw Error(where + "expected 'timestamp tx ty tz qx qy qz qw'");
+      if (!std::isfinite(v[k])) throw Error(where + "value " + std::to_string(k + 1) + " is not finite");
+    }
+    std::string extra;
+    if (fields >> extra) throw Error(where + "unexpected trailing text '" + extra + "'");
+    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    if (!(q.norm() > 1e-6)) throw Error(where + "zero quaternion");
+    q.normalize();
+    poses.push_back({v[0], Pose::fromCameraToWorld(q.toRotationMatrix(), Eigen::Vector3d(v[1], v[2], v[3]))});
+  }
+  if (poses.empty()) throw Error(path + ": no poses found (empty trajectory)");
+  return poses;
+}
+
+void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses) {
+  std::ostringstream out;
+  out << "# timestamp tx ty tz qx qy qz qw (camera->world)\n" << std::setprecision(17);
+  for (const StampedPose& p : poses) {
+    if (!p.pose.isValid() || !std::isfinite(p.timestamp)) throw Error(path + ": refusing to write an invalid pose");
+    const Pose inv = p.pose.inverse();  // camera->world
+    const Eigen::Quaterniond q(inv.rotation());
+    const Eigen::Vector3d& t = inv.translation();
+    out << std::fixed << std::setprecision(6) << p.timestamp << std::defaultfloat << std::setprecision(17) << ' '
+        << t(0) << ' ' << t(1) << ' ' << t(2) << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << '\n';
+  }
+  writeFileAtomically(path, out.str());
+}
+
+std::optional<size_t> findNearest(const std::vector<StampedPose>& poses, double t, double tolerance) {
+  std::optional<size_t> best;
+  double best_dt = tolerance;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const double dt = std::abs(poses[i].timestamp - t);
+    if (dt <= best_dt) best = i, best_dt = dt;
+  }
+  return best;
+}
+
+}  // namespace ellreloc::io

@@ -1,0 +1,208 @@
+#include "ellreloc/core/distances.hpp"
+
+#include "../random_geometry.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include <limits>
+
+using namespace ellreloc;
+using ellreloc::test::uniform;
+
+namespace {
+
+/// Square root of a symmetric PSD matrix by eigen decomposition (rounding can push an
+/// eigenvalue of a thin ellipse slightly below zero: clamp it).
+Eigen::Matrix2d sqrtm(const Eigen::Matrix2d& S) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(S);
+  const Eigen::Vector2d root = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  return eig.eigenvectors() * root.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+/// W2^2 through generic matrix square roots (the textbook formula).
+double w2SquaredReference(const Ellipse& a, const Ellipse& b) {
+  const Eigen::Matrix2d S1 = a.covariance(), S2 = b.covariance();
+  const Eigen::Matrix2d r1 = sqrtm(S1);
+  const Eigen::Matrix2d cross = sqrtm(r1 * S2 * r1);
+  return (a.center() - b.center()).squaredNorm() + (S1 + S2 - 2.0 * cross).trace();
+}
+
+/// IoU by counting the centres of a fine grid of cells over the union's bounding box.
+double iouRaster(const Ellipse& a, const Ellipse& b, int n) {
+  const Box ba = a.boundingBox(), bb = b.boundingBox();
+  const Box u(std::min(ba.x1, bb.x1), std::min(ba.y1, bb.y1), std::max(ba.x2, bb.x2), std::max(ba.y2, bb.y2));
+  const double dx = u.width() / n, dy = u.height() / n;
+  // (x-c)^T S^-1 (x-c) <= 1 with precomputed inverse covariances, to keep this fast.
+  const Eigen::Matrix2d Ia = a.covariance().inverse(), Ib = b.covariance().inverse();
+  long inter = 0, uni = 0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector2d p(u.x1 + (i + 0.5) * dx, u.y1 + (j + 0.5) * dy);
+      const Eigen::Vector2d da = p - a.center(), db = p - b.center();
+      const bool ina = da.dot(Ia * da) <= 1.0, inb = db.dot(Ib * db) <= 1.0;
+      inter += ina && inb;
+      uni += ina || inb;
+    }
+  }
+  return uni ? static_cast<double>(inter) / uni : 0.0;
+}
+
+Ellipse nearby(std::mt19937& rng, const Ellipse& e) {
+  return Ellipse(e.center() + Eigen::Vector2d(uniform(rng, -1, 1), uniform(rng, -1, 1)) * e.axes()(0),
+                 {uniform(rng, 5, 120), uniform(rng, 5, 120)}, uniform(rng, -M_PI, M_PI));
+}
+
+}  // namespace
+
+TEST(Wasserstein, AgreesWithMatrixSquareRootEvaluation) {
+  std::mt19937 rng(31);
+  for (int i = 0; i < 1000; ++i) {
+    const Ellipse a = ellreloc::test::randomEllipse(rng), b = ellreloc::test::randomEllipse(rng);
+    const double ref = w2SquaredReference(a, b);
+    EXPECT_NEAR(wasserstein2Squared(a, b), ref, 1e-9 * std::max(1.0, ref));
+    EXPECT_NEAR(wasserstein2Squared(a, b), wasserstein2Squared(b, a), 1e-9 * std::max(1.0, ref));
+  }
+}
+
+TEST(Wasserstein, ExactlyZeroForEqualEllipses) {
+  std::mt19937 rng(32);
+  for (int i = 0; i < 1000; ++i) {
+    const Ellipse a = ellreloc::test::randomEllipse(rng);
+    EXPECT_EQ(wasserstein2Squared(a, a), 0.0);
+  }
+}
+
+TEST(Wasserstein, SafeForNearDegenerateEllipses) {
+  std::mt19937 rng(33);
+  for (int i = 0; i < 500; ++i) {
+    const double a = uniform(rng, 1, 100);
+    const Ellipse thin({uniform(rng, 0, 100), 0}, {a, a * std::pow(10.0, uniform(rng, -9, -3))}, uniform(rng, -3, 3));
+    const Ellipse other = i % 2 ? thin : ellreloc::test::randomEllipse(rng);
+    const Ellipse thin2(thin.center(), {thin.axes()(0), thin.axes()(1) * 1.5}, thin.angle() + 1e-7);
+    for (const Ellipse& b : {other, thin2}) {
+      const double w = wasserstein2Squared(thin, b);
+      ASSERT_TRUE(std::isfinite(w));
+      EXPECT_GE(w, 0.0);
+      const double ref = w2SquaredReference(thin, b);
+      // The reference loses precision here itself; compare at the scale of the ellipses.
+      EXPECT_NEAR(w, ref, 1e-6 * (thin.covariance().norm() + b.covariance().norm()) + 1e-9);
+    }
+  }
+}
+
+TEST(Wasserstein, PureTranslationAndScaling) {
+  const Ellipse a({10, 20}, {30, 10}, 0.4);
+  const Ellipse moved({13, 24}, {30, 10}, 0.4);
+  EXPECT_NEAR(wasserstein2Squared(a, moved), 25.0, 1e-9);
+  // Concentric, same orientation: W2^2 = (a1 - a2)^2 + (b1 - b2)^2.
+  const Ellipse scaled({10, 20}, {33, 14}, 0.4);
+  EXPECT_NEAR(wasserstein2Squared(a, scaled), 9.0 + 16.0, 1e-9);
+}
+
+TEST(Bhattacharyya, AgreesWithNumericalIntegration) {
+  std::mt19937 rng(34);
+  for (int i = 0; i < 30; ++i) {
+    const Ellipse a = ellreloc::test::randomEllipse(rng);
+    const Ellipse b = nearby(rng, a);
+    // BC = integral of sqrt(p q), D_B = -ln BC, on a grid covering +-6 sigma of both.
+    const Eigen::Matrix2d Ia = a.covariance().inverse(), Ib = b.covariance().inverse();
+    const double na = 1.0 / (2 * M_PI * a.axes().prod()), nb = 1.0 / (2 * M_PI * b.axes().prod());
+    const Box ba = a.boundingBox(), bb = b.boundingBox();
+    const double x1 = std::min(a.center()(0) - 6 * (ba.width() / 2), b.center()(0) - 6 * (bb.width() / 2));
+    const double x2 = std::max(a.center()(0) + 6 * (ba.width() / 2), b.center()(0) + 6 * (bb.width() / 2));
+    const double y1 = std::min(a.center()(1) - 6 * (ba.height() / 2), b.center()(1) - 6 * (bb.height() / 2));
+    const double y2 = std::max(a.center()(1) + 6 * (ba.height() / 2), b.center()(1) + 6 * (bb.height() / 2));
+    const int n = 1200;
+    const double dx = (x2 - x1) / n, dy = (y2 - y1) / n;
+    double bc = 0.0;
+    for (int u = 0; u < n; ++u) {
+      for (int v = 0; v < n; ++v) {
+        const Eigen::Vector2d p(x1 + (u + 0.5) * dx, y1 + (v + 0.5) * dy);
+        const Eigen::Vector2d da = p - a.center(), db = p - b.center();
+        bc += std::sqrt(na * nb) * std::exp(-0.25 * (da.dot(Ia * da) + db.dot(Ib * db)));
+      }
+    }
+    bc *= dx * dy;
+    EXPECT_NEAR(bhattacharyya(a, b), -std::log(bc), 2e-3);
+  }
+  const Ellipse e({1, 2}, {3, 1}, 0.2);
+  EXPECT_NEAR(bhattacharyya(e, e), 0.0, 1e-12);
+}
+
+TEST(EllipseIoU, AgreesWithRasterisationTo1e3) {
+  std::mt19937 rng(35);
+  double worst = 0.0;
+  for (int i = 0; i < 150; ++i) {
+    const Ellipse a = ellreloc::test::randomEllipse(rng);
+    const Ellipse b = nearby(rng, a);
+    const double iou = ellipseIoU(a, b);
+    const double ref = iouRaster(a, b, 1500);
+    worst = std::max(worst, std::abs(iou - ref));
+    EXPECT_NEAR(iou, ref, 1e-3) << i;
+    EXPECT_DOUBLE_EQ(iou, ellipseIoU(b, a));
+  }
+  RecordProperty("worst_abs_error", std::to_string(worst));
+}
+
+TEST(EllipseIoU, SpecialCases) {
+  const Ellipse a({100, 100}, {40, 20}, 0.3);
+  EXPECT_NEAR(ellipseIoU(a, a), 1.0, 1e-3);
+  EXPECT_EQ(ellipseIoU(a, Ellipse({300, 100}, {40, 20}, 0.3)), 0.0);
+  // Nested: IoU = area ratio.
+  const Ellipse inner({100, 100}, {20, 10}, 0.3);
+  EXPECT_NEAR(ellipseIoU(a, inner), 0.25, 1e-3);
+  // Thin ellipses crossing at a right angle.
+  const Ellipse h({0, 0}, {100, 1}, 0.0), v({0, 0}, {100, 1}, M_PI / 2);
+  EXPECT_NEAR(ellipseIoU(h, v), iouRaster(h, v, 4000), 1e-3);
+  EXPECT_EQ(ellipseIoU(a, Ellipse({100, 100}, {0, 20}, 0.3)), 0.0);
+  EXPECT_EQ(ellipseIoU(a, Ellipse({std::nan(""), 100}, {10, 20}, 0.3)), 0.0);
+}
+
+TEST(BoxIoU, HandComputedAndDegenerate) {
+  EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(5, 0, 15, 10)), 50.0 / 150.0);
+  EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(0, 0, 10, 10)), 1.0);
+  EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(20, 20, 30, 30)), 0.0);
+  EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(2, 2, 4, 4)), 4.0 / 100.0);
+  EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 0, 0), Box(0, 0, 0, 0)), 0.0);
+  EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(std::nan(""), 0, 4, 4)), 0.0);
+  EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(8, 0, 4, 4)), 0.0);  // x2 < x1: invalid
+}
+
+TEST(LevelSet, ZeroForEqualSymmetricAndMonotoneInOffset) {
+  std::mt19937 rng(36);
+  for (int i = 0; i < 300; ++i) {
+    const Ellipse a = ellreloc::test::randomEllipse(rng);
+    EXPECT_NEAR(levelSetDistance(a, a), 0.0, 1e-9);
+    const Ellipse b = nearby(rng, a);
+    EXPECT_NEAR(levelSetDistance(a, b), levelSetDistance(b, a), 1e-9 * (1 + levelSetDistance(a, b)));
+    // Sliding a copy away along a fixed direction only increases the distance.
+    double previous = 0.0;
+    for (int k = 1; k <= 5; ++k) {
+      const Ellipse moved(a.center() + Eigen::Vector2d(0.2 * k * a.axes()(1), 0.0), a.axes(), a.angle());
+      const double d = levelSetDistance(a, moved);
+      EXPECT_GT(d, previous);
+      previous = d;
+    }
+  }
+}
+
+TEST(LevelSet, MatchesTheDefinitionOnAConcentricScaledCircle) {
+  // Circles of radius 1 and 2: the level-s points of the small one have radius s/2 in the big
+  // one (residual -s/2), and the level-s points of the big one have radius 2s (residual s).
+  const Ellipse small({0, 0}, {1, 1}, 0.0), big({0, 0}, {2, 2}, 0.0);
+  const double mean_sq = (0.25 * (0.25 + 1.0 + 2.25) + (0.25 + 1.0 + 2.25)) / 6.0;
+  EXPECT_NEAR(levelSetDistance(small, big), std::sqrt(mean_sq), 1e-12);
+}
+
+TEST(Distances, InvalidInputGivesInfinityNotNaN) {
+  const Ellipse good({0, 0}, {2, 1}, 0.0);
+  const Ellipse bad({0, 0}, {-2, 1}, 0.0);
+  const Ellipse nan({std::nan(""), 0}, {2, 1}, 0.0);
+  for (const Ellipse& b : {bad, nan}) {
+    EXPECT_TRUE(std::isinf(wasserstein2Squared(good, b)));
+    EXPECT_TRUE(std::isinf(bhattacharyya(good, b)));
+    EXPECT_TRUE(std::isinf(levelSetDistance(b, good)));
+    EXPECT_EQ(ellipseIoU(b, good), 0.0);
+  }
+}

@@ -1,0 +1,133 @@
+#include "ellreloc/core/projection.hpp"
+
+#include "../random_geometry.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include <limits>
+
+using namespace ellreloc;
+using ellreloc::test::uniform;
+
+namespace {
+
+/// Points of the occluding contour: on the unit sphere of the ellipsoid's normalised frame
+/// they are the circle y . o = 1 (o = camera centre in that frame), mapped back to the world.
+std::vector<Eigen::Vector3d> occludingContour(const Ellipsoid& e, const Eigen::Vector3d& camera_center, int n) {
+  const Eigen::Vector3d o = (e.rotation().transpose() * (camera_center - e.center())).cwiseQuotient(e.axes());
+  const double d2 = o.squaredNorm();
+  const Eigen::Vector3d p0 = o / d2;
+  const double r = std::sqrt(1.0 - 1.0 / d2);
+  const Eigen::Vector3d u = o.unitOrthogonal(), v = o.normalized().cross(u);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2.0 * M_PI * i / n;
+    const Eigen::Vector3d y = p0 + r * (std::cos(t) * u + std::sin(t) * v);
+    points.push_back(e.center() + e.rotation() * e.axes().cwiseProduct(y));
+  }
+  return points;
+}
+
+}  // namespace
+
+TEST(Projection, SurfaceProjectsInsideAndContourOnTheEllipse) {
+  std::mt19937 rng(21);
+  const Intrinsics K = ellreloc::test::testIntrinsics();
+  int checked = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Ellipsoid e = ellreloc::test::randomEllipsoid(rng);
+    const Pose pose = ellreloc::test::randomLookAtPose(rng);
+    const Projection proj = project(e, K, pose);
+    ASSERT_TRUE(proj.ok()) << toString(proj.status);
+    ++checked;
+    double max_radius = 0.0;
+    for (const auto& x : e.sampleSurface(500)) {
+      const double r = proj.ellipse.mahalanobisRadius(K.project(pose.transform(x)));
+      EXPECT_LE(r, 1.0 + 1e-9);
+      max_radius = std::max(max_radius, r);
+    }
+    EXPECT_GT(max_radius, 0.95);  // the projection is tight, not just an enclosing ellipse
+    for (const auto& x : occludingContour(e, pose.center(), 24)) {
+      EXPECT_NEAR(proj.ellipse.mahalanobisRadius(K.project(pose.transform(x))), 1.0, 1e-8);
+    }
+  }
+  EXPECT_EQ(checked, 300);
+}
+
+TEST(Projection, AgreesWithOpenCvProjectPoints) {
+  std::mt19937 rng(22);
+  const Intrinsics K = ellreloc::test::testIntrinsics();
+  cv::Mat cvK;
+  cv::eigen2cv(K.K(), cvK);
+  for (int i = 0; i < 200; ++i) {
+    const Ellipsoid e = ellreloc::test::randomEllipsoid(rng);
+    const Pose pose = ellreloc::test::randomLookAtPose(rng);
+    const Projection proj = project(e, K, pose);
+    ASSERT_TRUE(proj.ok());
+    std::vector<cv::Point3d> object;
+    for (const auto& x : occludingContour(e, pose.center(), 36)) object.emplace_back(x(0), x(1), x(2));
+    cv::Mat R, rvec, tvec;
+    cv::eigen2cv(pose.rotation(), R);
+    cv::Rodrigues(R, rvec);
+    cv::eigen2cv(pose.translation(), tvec);
+    std::vector<cv::Point2d> image;
+    cv::projectPoints(object, rvec, tvec, cvK, cv::noArray(), image);
+    // The contour's image is the ellipse: fit a conic through it with OpenCV's own points and
+    // compare through the boundary equation, and compare the bounding boxes.
+    double x1 = 1e18, y1 = 1e18, x2 = -1e18, y2 = -1e18;
+    for (const auto& p : image) {
+      EXPECT_NEAR(proj.ellipse.mahalanobisRadius({p.x, p.y}), 1.0, 1e-7);
+      x1 = std::min(x1, p.x), y1 = std::min(y1, p.y), x2 = std::max(x2, p.x), y2 = std::max(y2, p.y);
+    }
+    const Box b = proj.ellipse.boundingBox();
+    EXPECT_LE(b.x1, x1 + 1e-6);
+    EXPECT_GE(b.x2, x2 - 1e-6);
+    EXPECT_LE(b.y1, y1 + 1e-6);
+    EXPECT_GE(b.y2, y2 - 1e-6);
+  }
+}
+
+TEST(Projection, FailuresAreStatusesNotNaN) {
+  const Intrinsics K = ellreloc::test::testIntrinsics();
+  const Pose identity;  // camera at the origin looking along +z
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+
+  EXPECT_TRUE(project(Ellipsoid({0, 0, 3}, {0.2, 0.3, 0.4}, I), K, identity).ok());
+  EXPECT_EQ(project(Ellipsoid({0, 0, -3}, {0.2, 0.3, 0.4}, I), K, identity).status, ProjectionStatus::BehindCamera);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 0.1}, {0.5, 0.5, 0.5}, I), K, identity).status,
+            ProjectionStatus::ContainsCamera);
+  EXPECT_EQ(project(Ellipsoid({1, 0, 0.1}, {0.2, 0.2, 0.2}, I), K, identity).status,
+            ProjectionStatus::NotAnEllipse);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, 0.0, 0.4}, I), K, identity).status, ProjectionStatus::InvalidInput);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, -1.0, 0.4}, I), K, identity).status, ProjectionStatus::InvalidInput);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, nan, 0.4}, I), K, identity).status, ProjectionStatus::InvalidInput);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, 0.3, std::numeric_limits<double>::infinity()}, I), K, identity).status,
+            ProjectionStatus::InvalidInput);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, 0.3, 0.4}, I), K, Pose(I, {nan, 0, 0})).status,
+            ProjectionStatus::InvalidInput);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, 0.3, 0.4}, I), Intrinsics(0, 500, 320, 240, 640, 480), identity).status,
+            ProjectionStatus::InvalidInput);
+
+  // Random placements around the camera: every result is either a valid ellipse or a status.
+  std::mt19937 rng(23);
+  int ok = 0, failed = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Ellipsoid e({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
+                      {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
+                      ellreloc::test::randomRotation(rng));
+    const Projection p = project(e, K, identity);
+    if (p.ok()) {
+      EXPECT_TRUE(p.ellipse.isValid());
+      // In front of the camera: every surface point has positive depth.
+      for (const auto& x : e.sampleSurface(50)) EXPECT_GT(x(2), 0.0);
+      ++ok;
+    } else {
+      ++failed;
+    }
+  }
+  EXPECT_GT(ok, 100);
+  EXPECT_GT(failed, 100);
+}

@@ -1,0 +1,69 @@
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/files.hpp"
+
+#include "../data_dir.hpp"
+#include "temp_dir.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace ellreloc;
+
+TEST(CameraIo, ReadsTheOrbSlamYamlOfFr2) {
+  const Intrinsics K = io::readCamera(test::dataPath("tum_fr2_desk/camera.yaml"));
+  EXPECT_DOUBLE_EQ(K.fx, 520.90862);
+  EXPECT_DOUBLE_EQ(K.fy, 521.007327);
+  EXPECT_DOUBLE_EQ(K.cx, 325.141442);
+  EXPECT_DOUBLE_EQ(K.cy, 249.701764);
+  EXPECT_EQ(K.width, 640);
+  EXPECT_EQ(K.height, 480);
+}
+
+TEST(CameraIo, JsonAndYamlRoundTrips) {
+  test::TempDir dir;
+  const Intrinsics K(517.3, 516.5, 318.6, 255.3, 640, 480);
+  for (const std::string name : {"cam.json", "cam.yaml"}) {
+    io::writeCamera(dir.path(name), K);
+    const Intrinsics back = io::readCamera(dir.path(name));
+    EXPECT_DOUBLE_EQ(back.fx, K.fx);
+    EXPECT_DOUBLE_EQ(back.fy, K.fy);
+    EXPECT_DOUBLE_EQ(back.cx, K.cx);
+    EXPECT_DOUBLE_EQ(back.cy, K.cy);
+    EXPECT_EQ(back.width, K.width);
+    EXPECT_EQ(back.height, K.height);
+  }
+}
+
+TEST(CameraIo, MalformedFilesNameTheFileAndKey) {
+  test::TempDir dir;
+  struct Case {
+    std::string name, content, expected;
+  };
+  const std::vector<Case> cases = {
+      {"empty.json", "", "empty file"},
+      {"trunc.json", "{\"fx\": 500, \"fy\":", "invalid JSON"},
+      {"missing.json", "{\"fx\": 500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640}", "height: missing"},
+      {"type.json", "{\"fx\": \"500\", \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640, \"height\": 480}", "fx: expected a number"},
+      {"neg.json", "{\"fx\": -500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640, \"height\": 480}", "positive"},
+      {"zero.json", "{\"fx\": 500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 0, \"height\": 480}", "positive"},
+      {"frac.json", "{\"fx\": 500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640.5, \"height\": 480}", "width: expected an integer"},
+      {"array.json", "[1, 2, 3]", "expected an object"},
+      {"empty.yaml", "  \n", "empty file"},
+      {"missing.yaml", "%YAML:1.0\nCamera.fx: 500\nCamera.fy: 500\nCamera.cx: 320\nCamera.width: 640\nCamera.height: 480\n", "Camera.cy: missing"},
+      {"text.yaml", "%YAML:1.0\nCamera.fx: abc\nCamera.fy: 500\nCamera.cx: 320\nCamera.cy: 2\nCamera.width: 640\nCamera.height: 480\n", "Camera.fx"},
+  };
+  for (const Case& c : cases) {
+    io::writeFileAtomically(dir.path(c.name), c.content);
+    try {
+      io::readCamera(dir.path(c.name));
+      ADD_FAILURE() << c.name << " was accepted";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(c.name), std::string::npos) << what;
+      EXPECT_NE(what.find(c.expected), std::string::npos) << c.name << ": " << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+    }
+  }
+  EXPECT_THROW(io::readCamera(dir.path("does-not-exist.yaml")), Error);
+  EXPECT_THROW(io::readCamera(dir.path("")), Error);  // a directory
+}

@@ -1,0 +1,143 @@
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/files.hpp"
+#include "ellreloc/io/map.hpp"
+
+#include "../data_dir.hpp"
+#include "../random_geometry.hpp"
+#include "temp_dir.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sstream>
+
+using namespace ellreloc;
+
+TEST(MapIo, ReadsTheFr2MapAndItsDualQuadricsAgree) {
+  const std::string path = test::dataPath("tum_fr2_desk/map.json");
+  const ObjectMap map = io::readMap(path);
+  ASSERT_EQ(map.objects.size(), 47u);
+  EXPECT_EQ(map.objects[0].category, 66);
+  EXPECT_EQ(map.objects[0].label, "keyboard");
+  // The file stores each object twice: as centre/axes/rotation and as a float32 dual quadric.
+  const auto j = nlohmann::json::parse(io::readTextFile(path));
+  for (size_t i = 0; i < map.objects.size(); ++i) {
+    const Ellipsoid& e = map.objects[i].ellipsoid;
+    EXPECT_TRUE(e.isValid());
+    Eigen::Matrix4d Q;
+    for (int k = 0; k < 16; ++k) Q(k / 4, k % 4) = j["objects"][i]["dual_quadric"][static_cast<size_t>(k)].get<double>();
+    const auto from_q = Ellipsoid::fromDualQuadric(Q);
+    ASSERT_TRUE(from_q.has_value());
+    EXPECT_LT((from_q->center() - e.center()).norm(), 1e-5);
+    EXPECT_LT((from_q->shapeMatrix() - e.shapeMatrix()).norm(), 1e-5 * e.shapeMatrix().norm() + 1e-7);
+  }
+}
+
+TEST(MapIo, JsonRoundTripAndDualQuadricForm) {
+  std::mt19937 rng(41);
+  ObjectMap map;
+  for (int i = 0; i < 20; ++i) map.objects.push_back({i * 3, i % 5, i % 2 ? "cup" : "", test::randomEllipsoid(rng)});
+  map.points = {{0.1, 0.2, 0.3}, {-1, 2, 5}};
+  test::TempDir dir;
+  io::writeMap(dir.path("map.json"), map);
+  const ObjectMap back = io::readMap(dir.path("map.json"));
+  ASSERT_EQ(back.objects.size(), map.objects.size());
+  ASSERT_EQ(back.points.size(), 2u);
+  EXPECT_EQ(back.points[1], map.points[1]);
+  for (size_t i = 0; i < map.objects.size(); ++i) {
+    EXPECT_EQ(back.objects[i].id, map.objects[i].id);
+    EXPECT_EQ(back.objects[i].category, map.objects[i].category);
+    EXPECT_EQ(back.objects[i].label, map.objects[i].label);
+    EXPECT_LT((back.objects[i].ellipsoid.dualQuadric() - map.objects[i].ellipsoid.dualQuadric()).norm(), 1e-12);
+  }
+  // Objects given only as a dual quadric, at gtsam's +1 normalisation.
+  nlohmann::json j = {{"objects", nlohmann::json::array()}};
+  for (const MapObject& o : map.objects) {
+    const Eigen::Matrix4d Q = -o.ellipsoid.dualQuadric();
+    std::vector<double> q;
+    for (int k = 0; k < 16; ++k) q.push_back(Q(k / 4, k % 4));
+    j["objects"].push_back({{"id", o.id}, {"category", o.category}, {"dual_quadric", q}});
+  }
+  const ObjectMap from_q = io::parseMapJson(j.dump(), "inline");
+  for (size_t i = 0; i < map.objects.size(); ++i)
+    EXPECT_LT((from_q.objects[i].ellipsoid.shapeMatrix() - map.objects[i].ellipsoid.shapeMatrix()).norm(), 1e-12);
+}
+
+TEST(MapIo, ReadsOaSlamTextMaps) {
+  std::mt19937 rng(42);
+  std::ostringstream text;
+  text.precision(17);
+  std::vector<Ellipsoid> truth;
+  for (int i = 0; i < 10; ++i) {
+    truth.push_back(test::randomEllipsoid(rng));
+    const Eigen::Matrix4d Q = truth.back().dualQuadric() * 3.7;  // any scale
+    text << i + 100 << " " << i % 3;
+    for (int k = 0; k < 16; ++k) text << " " << Q(k % 4, k / 4);  // column-major
+    text << "\n";
+  }
+  test::TempDir dir;
+  io::writeFileAtomically(dir.path("map_objects_0.txt"), text.str());
+  const ObjectMap map = io::readMap(dir.path("map_objects_0.txt"));
+  ASSERT_EQ(map.objects.size(), 10u);
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_EQ(map.objects[i].id, i + 100);
+    EXPECT_EQ(map.objects[i].category, i % 3);
+    EXPECT_LT((map.objects[i].ellipsoid.center() - truth[i].center()).norm(), 1e-9);
+    EXPECT_LT((map.objects[i].ellipsoid.shapeMatrix() - truth[i].shapeMatrix()).norm(), 1e-9);
+  }
+}
+
+TEST(MapIo, MalformedMapsNameTheFileAndField) {
+  const std::string obj = R"({"id": 1, "category": 41, "center": [0, 0, 1], "axes": [0.1, 0.1, 0.2], "rotation": [[1,0,0],[0,1,0],[0,0,1]]})";
+  struct Case {
+    std::string content, expected;
+  };
+  const std::vector<Case> cases = {
+      {"", "empty file"},
+      {"{\"objects\": [" + obj.substr(0, 40), "invalid JSON"},
+      {"{\"ellreloc_map\": 1}", "objects: missing"},
+      {"{\"objects\": {}}", "objects: expected an array"},
+      {"{\"ellreloc_map\": 2, \"objects\": []}", "unsupported version"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].center: expected an array of 3"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,-1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].axes: semi-axes must be positive"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,0,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].axes"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,1,1], "rotation": [[2,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].rotation: not a rotation"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0]]}]})", "objects[0].rotation"},
+      {R"({"objects": [{"id": "a", "category": 41}]})", "objects[0].id: expected an integer"},
+      {R"({"objects": [{"id": 1, "category": 41.5}]})", "objects[0].category: expected an integer"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, "x", 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].center[1]: expected a number"},
+      {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]})", "objects[0].dual_quadric: does not describe a real ellipsoid"},
+      {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0]}]})", "objects[0].dual_quadric: expected 16"},
+      {"{\"objects\": [" + obj + "], \"points\": [[1, 2]]}", "points[0]: expected an array of 3"},
+      {"{\"objects\": [" + obj + ", 5]}", "objects[1]: expected an object"},
+      {"7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0\n", "line 1: expected 16 dual-quadric entries, found 15"},
+      {"7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 -1 9\n", "line 1: unexpected trailing text"},
+      {"# comment\n7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n", "line 2: does not describe a real ellipsoid"},
+      {"seven 41\n", "line 1: expected 'track_id category_id'"},
+      {"7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 nan\n", "line 1"},
+  };
+  test::TempDir dir;
+  int n = 0;
+  for (const Case& c : cases) {
+    const std::string path = dir.path("map" + std::to_string(n++) + ".json");
+    io::writeFileAtomically(path, c.content);
+    try {
+      io::readMap(path);
+      ADD_FAILURE() << "accepted: " << c.content;
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(path, 0), 0u) << what;
+      EXPECT_NE(what.find(c.expected), std::string::npos) << "expected '" << c.expected << "' in: " << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
+
+TEST(MapIo, WritingAnInvalidMapLeavesNoFile) {
+  test::TempDir dir;
+  ObjectMap map;
+  map.objects.push_back({1, 2, "", Ellipsoid({0, 0, 0}, {1, -1, 1}, Eigen::Matrix3d::Identity())});
+  EXPECT_THROW(io::writeMap(dir.path("out.json"), map), Error);
+  EXPECT_FALSE(std::filesystem::exists(dir.path("out.json")));
+  EXPECT_THROW(io::writeMap(dir.path("no/such/dir/out.json"), ObjectMap{}), Error);
+}

@@ -1,0 +1,48 @@
+#pragma once
+// Seeded random geometry shared by the tests.
+
+#include "ellreloc/core.hpp"
+
+#include <Eigen/Geometry>
+
+#include <random>
+
+namespace ellreloc::test {
+
+inline double uniform(std::mt19937& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+inline Eigen::Matrix3d randomRotation(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  return Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
+}
+
+inline Ellipse randomEllipse(std::mt19937& rng) {
+  return Ellipse({uniform(rng, 50, 600), uniform(rng, 50, 400)}, {uniform(rng, 5, 120), uniform(rng, 5, 120)},
+                 uniform(rng, -M_PI, M_PI));
+}
+
+inline Ellipsoid randomEllipsoid(std::mt19937& rng) {
+  return Ellipsoid({uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)},
+                   {uniform(rng, 0.05, 0.5), uniform(rng, 0.05, 0.5), uniform(rng, 0.05, 0.5)}, randomRotation(rng));
+}
+
+/// A camera 2.5-4 m from the origin looking at a point near it (up = world z).
+inline Pose randomLookAtPose(std::mt19937& rng) {
+  const Eigen::Vector3d center = Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -0.5, 0.5))
+                                     .normalized() * uniform(rng, 2.5, 4.0);
+  const Eigen::Vector3d target(uniform(rng, -0.2, 0.2), uniform(rng, -0.2, 0.2), uniform(rng, -0.2, 0.2));
+  const Eigen::Vector3d z = (target - center).normalized();
+  Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ());
+  if (x.norm() < 1e-6) x = Eigen::Vector3d::UnitX();
+  x.normalize();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d R_wc;
+  R_wc << x, y, z;
+  return Pose::fromCameraToWorld(R_wc, center);
+}
+
+inline Intrinsics testIntrinsics() { return Intrinsics(525.0, 520.0, 319.5, 239.5, 640, 480); }
+
+}  // namespace ellreloc::test
