@@ -1,0 +1,219 @@
+#pragma once
+/// \file ransac.hpp
+/// A generic RANSAC engine (header-only) over a duck-typed estimator, with pluggable samplers
+/// (exhaustive enumeration, uniform random, PROSAC), MSAC-style scoring, an adaptive iteration
+/// count with clamps, an explicit seed, hypothesis and time budgets, and statistics.
+///
+/// An Estimator provides:
+///   using Model = ...;                       // a hypothesis
+///   static constexpr int kSampleSize;        // minimal sample size
+///   static constexpr int kMaxModels;         // models one minimal sample can produce
+///   size_t numData() const;
+///   int generate(const int* sample, Model* models) const;      // fills up to kMaxModels
+///   double score(const Model& m, int* num_inliers) const;       // MSAC cost: lower is better
+///   void refine(Model* m) const;                                // e.g. least squares on inliers
+/// A sample the estimator cannot use (e.g. repeated observations) simply generates 0 models.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <vector>
+
+namespace ellreloc {
+
+struct RansacOptions {
+  int min_iterations = 20;         ///< samples drawn at least (unless the sampler runs out)
+  int max_iterations = 10000;      ///< samples drawn at most
+  long max_hypotheses = 1000000;   ///< models scored at most
+  double max_time_ms = 0.0;        ///< wall-clock budget; 0 = none
+  double success_probability = 0.9999;  ///< for the adaptive iteration count
+  uint64_t seed = 0;               ///< same input + seed = same output
+  bool refine = true;              ///< call Estimator::refine on the best model
+};
+
+struct RansacStats {
+  int iterations = 0;          ///< samples drawn
+  long hypotheses = 0;         ///< models generated and scored
+  int best_iteration = 0;      ///< the sample (1-based) that produced the returned model
+  int num_inliers = 0;         ///< of the returned model
+  double score = std::numeric_limits<double>::infinity();  ///< MSAC cost of the returned model
+  double elapsed_ms = 0.0;
+  bool budget_exhausted = false;  ///< stopped by max_iterations, max_hypotheses or max_time_ms
+  bool sampler_exhausted = false; ///< an exhaustive sampler enumerated everything
+};
+
+/// Draws k distinct indices of [0, n) uniformly.
+class UniformSampler {
+ public:
+  UniformSampler(int n, int k, uint64_t seed) : n_(n), k_(k), rng_(seed) {}
+  bool next(int* sample) {
+    if (n_ < k_) return false;
+    for (int i = 0; i < k_; ++i) {
+      bool fresh;
+      do {
+        sample[i] = std::uniform_int_distribution<int>(0, n_ - 1)(rng_);
+        fresh = std::find(sample, sample + i, sample[i]) == sample + i;
+      } while (!fresh);
+    }
+    return true;
+  }
+
+ private:
+  int n_, k_;
+  std::mt19937_64 rng_;
+};
+
+/// Enumerates every k-subset of [0, n) once, in lexicographic order.
+class ExhaustiveSampler {
+ public:
+  ExhaustiveSampler(int n, int k, uint64_t /*seed*/ = 0) : n_(n), k_(k), current_(static_cast<size_t>(k)) {
+    std::iota(current_.begin(), current_.end(), 0);
+    done_ = n < k || k <= 0;
+  }
+  bool next(int* sample) {
+    if (done_) return false;
+    std::copy(current_.begin(), current_.end(), sample);
+    // Advance: the rightmost index that can still move, then reset the ones after it.
+    int i = k_ - 1;
+    while (i >= 0 && current_[i] == n_ - k_ + i) --i;
+    if (i < 0) {
+      done_ = true;
+    } else {
+      ++current_[i];
+      for (int j = i + 1; j < k_; ++j) current_[j] = current_[j - 1] + 1;
+    }
+    return true;
+  }
+
+ private:
+  int n_, k_;
+  std::vector<int> current_;
+  bool done_;
+};
+
+/// PROSAC (Chum & Matas, CVPR 2005): data indices are assumed sorted by decreasing quality
+/// (index 0 best). Samples are drawn from a growing prefix, the newest element of the prefix
+/// always included, so good data is tried first; after `growth_max` samples it is uniform.
+class ProsacSampler {
+ public:
+  ProsacSampler(int n, int k, uint64_t seed, int growth_max = 20000)
+      : n_(n), k_(k), rng_(seed), growth_max_(growth_max), subset_(k) {
+    // T_n: expected number of samples from the first n among growth_max samples of all N.
+    t_n_ = growth_max_;
+    for (int i = 0; i < k_; ++i) t_n_ *= static_cast<double>(k_ - i) / (n_ - i);
+    t_n_prime_ = 1;
+  }
+  bool next(int* sample) {
+    if (n_ < k_) return false;
+    ++t_;
+    if (t_ > t_n_prime_ && subset_ < n_) {
+      const double t_next = t_n_ * (subset_ + 1) / (subset_ + 1 - k_);
+      t_n_prime_ += static_cast<int>(std::ceil(t_next - t_n_));
+      t_n_ = t_next;
+      ++subset_;
+    }
+    if (t_n_prime_ < t_ || subset_ >= n_ || t_ > growth_max_) {
+      // Uniform over the current prefix.
+      drawDistinct(sample, 0, k_, subset_);
+    } else {
+      // k-1 from the first subset-1, plus element subset-1.
+      drawDistinct(sample, 0, k_ - 1, subset_ - 1);
+      sample[k_ - 1] = subset_ - 1;
+    }
+    return true;
+  }
+
+ private:
+  void drawDistinct(int* sample, int from, int to, int range) {
+    for (int i = from; i < to; ++i) {
+      bool fresh;
+      do {
+        sample[i] = std::uniform_int_distribution<int>(0, range - 1)(rng_);
+        fresh = std::find(sample, sample + i, sample[i]) == sample + i;
+      } while (!fresh);
+    }
+  }
+  int n_, k_;
+  std::mt19937_64 rng_;
+  int growth_max_;
+  int subset_;
+  long t_ = 0;
+  double t_n_ = 0;
+  long t_n_prime_ = 1;
+};
+
+/// Number of samples needed to draw an all-inlier sample with the given probability.
+inline int adaptiveIterations(double inlier_ratio, int sample_size, double success_probability) {
+  if (inlier_ratio >= 1.0) return 0;
+  if (inlier_ratio <= 0.0) return std::numeric_limits<int>::max();
+  const double p_good = std::pow(inlier_ratio, sample_size);
+  if (p_good <= 1e-300) return std::numeric_limits<int>::max();
+  const double k = std::log(1.0 - success_probability) / std::log(1.0 - p_good);
+  return k > 1e9 ? std::numeric_limits<int>::max() : static_cast<int>(std::ceil(k));
+}
+
+/// Runs RANSAC. `best` receives the best model; returns false when no model was generated.
+template <typename Estimator, typename Sampler>
+bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& options, typename Estimator::Model* best,
+            RansacStats* stats) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  RansacStats st;
+  int sample[Estimator::kSampleSize];
+  typename Estimator::Model models[Estimator::kMaxModels];
+  const size_t n = estimator.numData();
+  int needed = options.max_iterations;
+  bool have = false;
+  while (true) {
+    if (st.iterations >= options.max_iterations || st.hypotheses >= options.max_hypotheses) {
+      st.budget_exhausted = true;
+      break;
+    }
+    if (st.iterations >= std::max(options.min_iterations, needed)) break;
+    if (options.max_time_ms > 0.0 && (st.iterations & 7) == 0 &&
+        std::chrono::duration<double, std::milli>(Clock::now() - start).count() > options.max_time_ms) {
+      st.budget_exhausted = true;
+      break;
+    }
+    if (!sampler.next(sample)) {
+      st.sampler_exhausted = true;
+      break;
+    }
+    ++st.iterations;
+    const int m = estimator.generate(sample, models);
+    for (int i = 0; i < m; ++i) {
+      ++st.hypotheses;
+      int inliers = 0;
+      const double score = estimator.score(models[i], &inliers);
+      if (score < st.score) {
+        st.score = score;
+        st.num_inliers = inliers;
+        st.best_iteration = st.iterations;
+        *best = models[i];
+        have = true;
+        needed = adaptiveIterations(n ? static_cast<double>(inliers) / n : 0.0, Estimator::kSampleSize,
+                                    options.success_probability);
+      }
+    }
+  }
+  if (have && options.refine) {
+    typename Estimator::Model refined = *best;
+    estimator.refine(&refined);
+    int inliers = 0;
+    const double score = estimator.score(refined, &inliers);
+    if (score <= st.score) {  // refinement never makes the result worse
+      *best = refined;
+      st.score = score;
+      st.num_inliers = inliers;
+    }
+  }
+  st.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  if (stats) *stats = st;
+  return have;
+}
+
+}  // namespace ellreloc
