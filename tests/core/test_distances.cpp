@@ -206,3 +206,19 @@ TEST(Distances, InvalidInputGivesInfinityNotNaN) {
     EXPECT_EQ(ellipseIoU(b, good), 0.0);
   }
 }
+
+TEST(Wasserstein, ResidualSquaredNormIsW2Squared) {
+  std::mt19937 rng(37);
+  for (int i = 0; i < 1000; ++i) {
+    const Ellipse a = ellreloc::test::randomEllipse(rng), b = ellreloc::test::randomEllipse(rng);
+    double r[6];
+    wasserstein2Residual<double>(a.center(), a.covariance(), b.center(), b.covariance(), r);
+    const double sq = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3] + r[4] * r[4] + r[5] * r[5];
+    EXPECT_NEAR(sq, w2SquaredReference(a, b), 1e-9 * std::max(1.0, sq));
+    // The closed-form square root squares back to the covariance.
+    const Eigen::Matrix2d root = sqrtSpd2<double>(a.covariance());
+    EXPECT_LT((root * root - a.covariance()).norm(), 1e-9 * a.covariance().norm());
+    wasserstein2Residual<double>(a.center(), a.covariance(), a.center(), a.covariance(), r);
+    for (double v : r) EXPECT_NEAR(v, 0.0, 1e-9 * a.axes()(0));
+  }
+}

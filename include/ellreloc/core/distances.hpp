@@ -41,6 +41,47 @@ T wasserstein2Squared(const Vec2<T>& m1, const Mat2<T>& S1, const Vec2<T>& m2, c
   return (m1 - m2).squaredNorm() + cov_term;
 }
 
+/// Square root of a 2x2 symmetric positive definite matrix in closed form:
+///   sqrt(S) = (S + sqrt(det S) I) / sqrt(tr S + 2 sqrt(det S)).
+template <typename T>
+Mat2<T> sqrtSpd2(const Mat2<T>& S) {
+  using std::sqrt;
+  const T det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+  const T root_det = sqrt(det > T(0) ? det : T(0));
+  const T denom = sqrt(S(0, 0) + S(1, 1) + T(2) * root_det);
+  Mat2<T> R = S;
+  R(0, 0) += root_det;
+  R(1, 1) += root_det;
+  return R / denom;
+}
+
+/// A 6-vector whose squared norm is W2^2, for least squares (so the solver minimises W2^2,
+/// not W2^4). By the Procrustes form of the Bures distance,
+///   tr S1 + tr S2 - 2 tr (S1^1/2 S2 S1^1/2)^1/2 = min over rotations U of |S1^1/2 - S2^1/2 U|_F^2,
+/// and for 2x2 matrices the optimal U is the rotation by atan2(x01 - x10, x00 + x11) with
+/// X = S1^1/2 S2^1/2 (tr X > 0 for positive definite S1, S2, so it is always defined). The
+/// residual is [m1 - m2; vec(S1^1/2 - S2^1/2 U)]: smooth, no square root of W2 itself, and
+/// so no infinite derivative at W2 = 0. Templated for Ceres Jets.
+template <typename T>
+void wasserstein2Residual(const Vec2<T>& m1, const Mat2<T>& S1, const Vec2<T>& m2, const Mat2<T>& S2, T* r) {
+  using std::atan2;
+  using std::cos;
+  using std::sin;
+  const Mat2<T> A = sqrtSpd2(S1), B = sqrtSpd2(S2);
+  const Mat2<T> X = A * B;
+  const T theta = atan2(X(0, 1) - X(1, 0), X(0, 0) + X(1, 1));
+  const T c = cos(theta), s = sin(theta);
+  Mat2<T> U;
+  U << c, -s, s, c;
+  const Mat2<T> D = A - B * U;
+  r[0] = m1(0) - m2(0);
+  r[1] = m1(1) - m2(1);
+  r[2] = D(0, 0);
+  r[3] = D(0, 1);
+  r[4] = D(1, 0);
+  r[5] = D(1, 1);
+}
+
 inline double wasserstein2Squared(const Ellipse& a, const Ellipse& b) {
   if (!a.isValid() || !b.isValid()) return std::numeric_limits<double>::infinity();
   return wasserstein2Squared<double>(a.center(), a.covariance(), b.center(), b.covariance());

@@ -1,0 +1,224 @@
+#include "ellreloc/pose/wasserstein_refiner.hpp"
+
+#include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/projection.hpp"
+
+#include <ceres/jet.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+#include <limits>
+
+namespace ellreloc {
+
+namespace {
+
+using Jet = ceres::Jet<double, 6>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+/// rho(s) and rho'(s) of a loss on the squared residual s, with scale c (Ceres' convention:
+/// Huber rho = s for s <= c^2, 2 c sqrt(s) - c^2 beyond; Cauchy rho = c^2 log(1 + s / c^2)).
+void loss(RobustLoss type, double c, double s, double* rho, double* drho) {
+  switch (type) {
+    case RobustLoss::None:
+      *rho = s, *drho = 1.0;
+      return;
+    case RobustLoss::Huber:
+      if (s <= c * c) {
+        *rho = s, *drho = 1.0;
+      } else {
+        const double r = std::sqrt(s);
+        *rho = 2.0 * c * r - c * c, *drho = c / r;
+      }
+      return;
+    case RobustLoss::Cauchy:
+      *rho = c * c * std::log1p(s / (c * c)), *drho = 1.0 / (1.0 + s / (c * c));
+      return;
+  }
+}
+
+/// The camera-frame dual quadric of an ellipsoid at a pose: T Q* T^T with T = [R t; 0 1].
+Eigen::Matrix4d cameraDualQuadric(const Ellipsoid& e, const Pose& pose) {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = pose.rotation();
+  T.topRightCorner<3, 1>() = pose.translation();
+  return T * e.dualQuadric() * T.transpose();
+}
+
+/// Evaluates residuals (and optionally Jacobians w.r.t. the left perturbation
+/// delta = (omega, v): R <- Exp(omega) R, t <- Exp(omega) t + v) at `pose`.
+struct Problem {
+  const Intrinsics& K;
+  std::vector<const EllipseMatch*> objects;
+  std::vector<double> object_scale;  // sqrt(a b) of each observed ellipse
+  const std::vector<PointMatch>& points;
+  const RefinerOptions& opt;
+
+  /// Robust cost; false when an object no longer projects to an ellipse or a point is behind.
+  bool cost(const Pose& pose, double* total) const {
+    double sum = 0.0;
+    for (size_t i = 0; i < objects.size(); ++i) {
+      const Projection p = project(objects[i]->ellipsoid, K, pose);
+      if (!p) return false;
+      const double s = wasserstein2Squared(objects[i]->observed, p.ellipse) / (object_scale[i] * object_scale[i]);
+      double rho, drho;
+      loss(opt.object_loss, opt.object_loss_scale, s, &rho, &drho);
+      sum += rho;
+    }
+    for (const PointMatch& m : points) {
+      const Eigen::Vector3d x = pose.transform(m.point);
+      if (!(x(2) > 0.0)) return false;
+      const double s = (K.project(x) - m.observed).squaredNorm() / (opt.point_sigma_px * opt.point_sigma_px);
+      double rho, drho;
+      loss(opt.point_loss, opt.point_loss_scale, s, &rho, &drho);
+      sum += opt.point_weight * rho;
+    }
+    *total = sum;
+    return std::isfinite(sum);
+  }
+
+  /// Gauss-Newton normal equations (IRLS-weighted) at the pose.
+  bool normalEquations(const Pose& pose, Mat6* H, Vec6* g) const {
+    H->setZero();
+    g->setZero();
+    Jet delta[6];
+    for (int k = 0; k < 6; ++k) delta[k] = Jet(0.0, k);
+    // M(delta) = [Exp(omega) | v], applied to camera-frame quantities of the current pose.
+    Jet Rj[9];
+    ceres::AngleAxisToRotationMatrix(delta, ceres::RowMajorAdapter3x3(Rj));
+    Eigen::Matrix<Jet, 3, 4> M;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) M(r, c) = Rj[3 * r + c];
+      M(r, 3) = delta[3 + r];
+    }
+    const Eigen::Matrix<Jet, 3, 4> KM = K.K().cast<Jet>() * M;
+    for (size_t i = 0; i < objects.size(); ++i) {
+      const Eigen::Matrix4d Qc = cameraDualQuadric(objects[i]->ellipsoid, pose);
+      const Mat3<Jet> C = projectDualQuadric<Jet>(KM, Qc.cast<Jet>());
+      Vec2<Jet> mean;
+      Mat2<Jet> cov;
+      gaussianFromDualConic<Jet>(C, &mean, &cov);
+      const Ellipse& obs = objects[i]->observed;
+      Jet r[6];
+      wasserstein2Residual<Jet>(obs.center().cast<Jet>(), obs.covariance().cast<Jet>(), mean, cov, r);
+      Eigen::Matrix<double, 6, 6> J;  // rows: residual components
+      Vec6 res;
+      for (int k = 0; k < 6; ++k) {
+        res(k) = r[k].a / object_scale[i];
+        J.row(k) = r[k].v.transpose() / object_scale[i];
+      }
+      if (!J.allFinite() || !res.allFinite()) return false;
+      double rho, drho;
+      loss(opt.object_loss, opt.object_loss_scale, res.squaredNorm(), &rho, &drho);
+      *H += drho * J.transpose() * J;
+      *g += drho * J.transpose() * res;
+    }
+    for (const PointMatch& m : points) {
+      const Eigen::Vector3d xc = pose.transform(m.point);
+      Eigen::Matrix<Jet, 3, 1> x = M.leftCols<3>() * xc.cast<Jet>() + M.col(3);
+      const Jet u = K.fx * x(0) / x(2) + K.cx, v = K.fy * x(1) / x(2) + K.cy;
+      Eigen::Matrix<double, 2, 6> J;
+      Eigen::Vector2d res((u.a - m.observed(0)) / opt.point_sigma_px, (v.a - m.observed(1)) / opt.point_sigma_px);
+      J.row(0) = u.v.transpose() / opt.point_sigma_px;
+      J.row(1) = v.v.transpose() / opt.point_sigma_px;
+      double rho, drho;
+      loss(opt.point_loss, opt.point_loss_scale, res.squaredNorm(), &rho, &drho);
+      *H += opt.point_weight * drho * J.transpose() * J;
+      *g += opt.point_weight * drho * J.transpose() * res;
+    }
+    return H->allFinite() && g->allFinite();
+  }
+};
+
+Pose applyDelta(const Pose& pose, const Vec6& d) {
+  double R[9];
+  ceres::AngleAxisToRotationMatrix(d.data(), ceres::RowMajorAdapter3x3(R));
+  const Eigen::Matrix3d dR = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R);
+  // Re-orthonormalise: many small rotations accumulate rounding.
+  return Pose(nearestRotation(dR * pose.rotation()), dR * pose.translation() + d.tail<3>());
+}
+
+}  // namespace
+
+RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std::vector<EllipseMatch>& objects,
+                            const std::vector<PointMatch>& points, const RefinerOptions& options) {
+  RefinementResult result;
+  result.pose = initial;
+  result.fell_back = true;
+  const auto fillResiduals = [&](RefinementResult& r) {
+    r.object_residuals.clear();
+    for (const EllipseMatch& m : objects) {
+      const Projection p = project(m.ellipsoid, K, r.pose);
+      const double scale = std::sqrt(m.observed.axes().prod());
+      r.object_residuals.push_back(p && m.observed.isValid() ? wasserstein2(m.observed, p.ellipse) / scale : -1.0);
+    }
+    r.point_residuals.clear();
+    for (const PointMatch& m : points) {
+      const Eigen::Vector3d x = r.pose.transform(m.point);
+      r.point_residuals.push_back(x(2) > 0 ? (K.project(x) - m.observed).norm() : -1.0);
+    }
+  };
+  if (!K.isValid() || !initial.isValid()) {
+    result.message = "invalid intrinsics or initial pose";
+    fillResiduals(result);
+    return result;
+  }
+  Problem problem{K, {}, {}, points, options};
+  for (const EllipseMatch& m : objects) {
+    if (!m.observed.isValid() || !project(m.ellipsoid, K, initial)) continue;
+    problem.objects.push_back(&m);
+    problem.object_scale.push_back(std::sqrt(m.observed.axes().prod()));
+  }
+  if (problem.objects.empty() && points.empty()) {
+    result.message = "no usable correspondence (no object projects at the initial pose)";
+    fillResiduals(result);
+    return result;
+  }
+  double cost = 0.0;
+  if (!problem.cost(initial, &cost)) {
+    result.message = "cost not finite at the initial pose (a point behind the camera?)";
+    fillResiduals(result);
+    return result;
+  }
+  result.initial_cost = cost;
+  Pose pose = initial;
+  double lambda = 1e-4;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    result.iterations = it + 1;
+    Mat6 H;
+    Vec6 g;
+    if (!problem.normalEquations(pose, &H, &g)) break;
+    bool accepted = false;
+    while (lambda < 1e10) {
+      Mat6 A = H;
+      A.diagonal() += lambda * (H.diagonal().cwiseMax(1e-9));
+      const Vec6 step = -A.ldlt().solve(g);
+      double trial_cost;
+      if (step.allFinite() && problem.cost(applyDelta(pose, step), &trial_cost) && trial_cost < cost) {
+        const double decrease = cost - trial_cost;
+        pose = applyDelta(pose, step);
+        cost = trial_cost;
+        lambda = std::max(lambda / 10.0, 1e-12);
+        accepted = true;
+        if (decrease <= options.function_tolerance * (cost + 1e-12)) result.converged = true;
+        break;
+      }
+      lambda *= 10.0;
+    }
+    if (!accepted) {
+      result.converged = true;  // no step decreases the cost: a (local) minimum
+      break;
+    }
+    if (result.converged) break;
+  }
+  result.pose = pose;
+  result.final_cost = cost;
+  result.fell_back = false;
+  fillResiduals(result);
+  return result;
+}
+
+}  // namespace ellreloc
