@@ -1,12 +1,12 @@
 // Core geometry in ns per call: projection, W2, Bhattacharyya, IoU, level-set distance.
 // Run: ./build/benchmarks/bench_core --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
-#include "ellreloc/core.hpp"
-
 #include <benchmark/benchmark.h>
 
 #include <random>
 #include <vector>
+
+#include "ellreloc/core.hpp"
 
 using namespace ellreloc;
 
@@ -48,7 +48,8 @@ void BM_Project(benchmark::State& state) {
   std::vector<Ellipsoid> ellipsoids;
   for (int i = 0; i < 1024; ++i) {
     const Eigen::Matrix3d R = Eigen::AngleAxisd(u(rng) * 6, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    ellipsoids.emplace_back(Eigen::Vector3d(u(rng) * 4, u(rng) * 3, 3.0 + u(rng) * 2), Eigen::Vector3d(ax(rng), ax(rng), ax(rng)), R);
+    ellipsoids.emplace_back(Eigen::Vector3d(u(rng) * 4, u(rng) * 3, 3.0 + u(rng) * 2),
+                            Eigen::Vector3d(ax(rng), ax(rng), ax(rng)), R);
   }
   const Intrinsics K(525, 525, 319.5, 239.5, 640, 480);
   const Pose pose;

@@ -4,6 +4,7 @@
 #include "ellreloc/io/files.hpp"
 #include "json_fields.hpp"
 
+#include <cstdlib>
 #include <sstream>
 
 namespace ellreloc::io {
@@ -67,6 +68,19 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
       obj.label = o["label"].get<std::string>();
     }
     obj.ellipsoid = parseObjectGeometry(o, where);
+    if (o.contains("category_counts")) {
+      const json& counts = o["category_counts"];
+      const Where wc = where["category_counts"];
+      if (!counts.is_object()) wc.fail("expected an object {\"category\": count}");
+      for (const auto& [key, value] : counts.items()) {
+        char* end = nullptr;
+        const long c = std::strtol(key.c_str(), &end, 10);
+        if (key.empty() || *end != '\0' || c < -2147483647L || c > 2147483647L) wc[key].fail("key is not an integer category");
+        const double n = detail::finiteNumber(value, wc[key]);
+        if (n < 0.0) wc[key].fail("count must be >= 0");
+        obj.category_counts[static_cast<int>(c)] = n;
+      }
+    }
     map.objects.push_back(std::move(obj));
   }
   if (j.contains("points")) {
@@ -126,6 +140,11 @@ void writeMap(const std::string& path, const ObjectMap& map) {
     obj["center"] = {o.ellipsoid.center()(0), o.ellipsoid.center()(1), o.ellipsoid.center()(2)};
     obj["axes"] = {o.ellipsoid.axes()(0), o.ellipsoid.axes()(1), o.ellipsoid.axes()(2)};
     obj["rotation"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
+    if (!o.category_counts.empty()) {
+      json counts = json::object();
+      for (const auto& [c, n] : o.category_counts) counts[std::to_string(c)] = n;
+      obj["category_counts"] = std::move(counts);
+    }
     objects.push_back(std::move(obj));
   }
   json j = {{"ellreloc_map", 1}, {"objects", std::move(objects)}};

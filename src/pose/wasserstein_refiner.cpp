@@ -1,15 +1,14 @@
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
-#include "ellreloc/core/distances.hpp"
-#include "ellreloc/core/projection.hpp"
-
 #include <ceres/jet.h>
 #include <ceres/rotation.h>
 
 #include <Eigen/Cholesky>
-
 #include <cmath>
 #include <limits>
+
+#include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/projection.hpp"
 
 namespace ellreloc {
 

@@ -1,10 +1,10 @@
-#include "ellreloc/pose/p3p.hpp"
-#include "ellreloc/pose/ransac.hpp"
-
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <set>
+
+#include "ellreloc/pose/p3p.hpp"
+#include "ellreloc/pose/ransac.hpp"
 
 using namespace ellreloc;
 

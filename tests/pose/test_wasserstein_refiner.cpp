@@ -1,11 +1,9 @@
-#include "ellreloc/pose/wasserstein_refiner.hpp"
-
-#include "ellreloc/core/distances.hpp"
-#include "ellreloc/core/projection.hpp"
+#include <gtest/gtest.h>
 
 #include "../random_geometry.hpp"
-
-#include <gtest/gtest.h>
+#include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/pose/wasserstein_refiner.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;
@@ -27,13 +25,15 @@ Scene makeScene(std::mt19937& rng, int n, double centre_noise_px, double axis_no
   s.truth = test::randomLookAtPose(rng);
   while (static_cast<int>(s.matches.size()) < n) {
     const Ellipsoid e({uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -0.5, 0.5)},
-                      {uniform(rng, 0.05, 0.3), uniform(rng, 0.05, 0.3), uniform(rng, 0.05, 0.3)}, test::randomRotation(rng));
+                      {uniform(rng, 0.05, 0.3), uniform(rng, 0.05, 0.3), uniform(rng, 0.05, 0.3)},
+                      test::randomRotation(rng));
     const Projection p = project(e, K, s.truth);
     if (!p) continue;
     const Ellipse& el = p.ellipse;
-    const Ellipse noisy(el.center() + centre_noise_px * Eigen::Vector2d(normal(rng), normal(rng)),
-                        el.axes().cwiseProduct(Eigen::Vector2d(1 + axis_noise * normal(rng), 1 + axis_noise * normal(rng))),
-                        el.angle() + 0.5 * axis_noise * normal(rng));
+    const Ellipse noisy(
+        el.center() + centre_noise_px * Eigen::Vector2d(normal(rng), normal(rng)),
+        el.axes().cwiseProduct(Eigen::Vector2d(1 + axis_noise * normal(rng), 1 + axis_noise * normal(rng))),
+        el.angle() + 0.5 * axis_noise * normal(rng));
     s.matches.push_back({noisy, e});
   }
   for (int i = 0; i < n_points; ++i) {
@@ -151,7 +151,8 @@ TEST(WassersteinRefiner, DegenerateInputIsHandled) {
   EXPECT_TRUE(one.pose.isValid());
   // No match projects (the object is behind the camera at the initial pose): falls back.
   const Pose behind = Pose::fromCameraToWorld(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 10));
-  std::vector<EllipseMatch> m = {{Ellipse({320, 240}, {20, 10}, 0), Ellipsoid({0, 0, 0}, {0.1, 0.1, 0.1}, Eigen::Matrix3d::Identity())}};
+  std::vector<EllipseMatch> m = {
+      {Ellipse({320, 240}, {20, 10}, 0), Ellipsoid({0, 0, 0}, {0.1, 0.1, 0.1}, Eigen::Matrix3d::Identity())}};
   const RefinementResult fb = refinePose(K, behind, m);
   EXPECT_TRUE(fb.fell_back);
   EXPECT_FALSE(fb.message.empty());

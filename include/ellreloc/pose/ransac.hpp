@@ -26,24 +26,25 @@
 namespace ellreloc {
 
 struct RansacOptions {
-  int min_iterations = 20;         ///< samples drawn at least (unless the sampler runs out)
-  int max_iterations = 10000;      ///< samples drawn at most
-  long max_hypotheses = 1000000;   ///< models scored at most
-  double max_time_ms = 0.0;        ///< wall-clock budget; 0 = none
+  int min_iterations = 20;              ///< samples drawn at least (unless the sampler runs out)
+  int max_iterations = 10000;           ///< samples drawn at most
+  long max_hypotheses = 1000000;        ///< models scored at most
+  double max_time_ms = 0.0;             ///< wall-clock budget; 0 = none
   double success_probability = 0.9999;  ///< for the adaptive iteration count
-  uint64_t seed = 0;               ///< same input + seed = same output
-  bool refine = true;              ///< call Estimator::refine on the best model
+  uint64_t seed = 0;                    ///< same input + seed = same output
+  bool refine = true;                   ///< call Estimator::refine on the best model
+  int stop_at_inliers = 0;              ///< stop as soon as a model has this many inliers; 0 = never
 };
 
 struct RansacStats {
-  int iterations = 0;          ///< samples drawn
-  long hypotheses = 0;         ///< models generated and scored
-  int best_iteration = 0;      ///< the sample (1-based) that produced the returned model
-  int num_inliers = 0;         ///< of the returned model
+  int iterations = 0;                                      ///< samples drawn
+  long hypotheses = 0;                                     ///< models generated and scored
+  int best_iteration = 0;                                  ///< the sample (1-based) that produced the returned model
+  int num_inliers = 0;                                     ///< of the returned model
   double score = std::numeric_limits<double>::infinity();  ///< MSAC cost of the returned model
   double elapsed_ms = 0.0;
-  bool budget_exhausted = false;  ///< stopped by max_iterations, max_hypotheses or max_time_ms
-  bool sampler_exhausted = false; ///< an exhaustive sampler enumerated everything
+  bool budget_exhausted = false;   ///< stopped by max_iterations, max_hypotheses or max_time_ms
+  bool sampler_exhausted = false;  ///< an exhaustive sampler enumerated everything
 };
 
 /// Draws k distinct indices of [0, n) uniformly.
@@ -174,6 +175,7 @@ bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& o
       break;
     }
     if (st.iterations >= std::max(options.min_iterations, needed)) break;
+    if (have && needed == 0 && options.stop_at_inliers > 0 && st.num_inliers >= options.stop_at_inliers) break;
     if (options.max_time_ms > 0.0 && (st.iterations & 7) == 0 &&
         std::chrono::duration<double, std::milli>(Clock::now() - start).count() > options.max_time_ms) {
       st.budget_exhausted = true;
@@ -197,6 +199,7 @@ bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& o
         have = true;
         needed = adaptiveIterations(n ? static_cast<double>(inliers) / n : 0.0, Estimator::kSampleSize,
                                     options.success_probability);
+        if (options.stop_at_inliers > 0 && inliers >= options.stop_at_inliers) needed = 0;
       }
     }
   }

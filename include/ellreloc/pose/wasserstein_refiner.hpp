@@ -13,12 +13,12 @@
 /// squares. A step is accepted only when the robust cost decreases, so the returned pose never
 /// has a higher cost than the one given.
 
+#include <string>
+#include <vector>
+
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/ellipsoid.hpp"
-
-#include <string>
-#include <vector>
 
 namespace ellreloc {
 
@@ -28,9 +28,9 @@ struct RefinerOptions {
   RobustLoss object_loss = RobustLoss::Cauchy;
   double object_loss_scale = 0.5;  ///< in normalised W2 units (W2 / sqrt(a b))
   RobustLoss point_loss = RobustLoss::Huber;
-  double point_sigma_px = 2.0;     ///< keypoint residuals are divided by this
-  double point_loss_scale = 3.0;   ///< in units of point_sigma_px
-  double point_weight = 1.0;       ///< multiplies every point term
+  double point_sigma_px = 2.0;    ///< keypoint residuals are divided by this
+  double point_loss_scale = 3.0;  ///< in units of point_sigma_px
+  double point_weight = 1.0;      ///< multiplies every point term
   int max_iterations = 30;
   double function_tolerance = 1e-8;  ///< relative cost decrease that counts as converged
 };
@@ -48,13 +48,13 @@ struct PointMatch {
 };
 
 struct RefinementResult {
-  Pose pose;                    ///< the refined pose (the initial one when nothing improved)
-  double initial_cost = 0.0;    ///< robust cost at the given pose
-  double final_cost = 0.0;      ///< robust cost at the returned pose (<= initial_cost)
+  Pose pose;                  ///< the refined pose (the initial one when nothing improved)
+  double initial_cost = 0.0;  ///< robust cost at the given pose
+  double final_cost = 0.0;    ///< robust cost at the returned pose (<= initial_cost)
   int iterations = 0;
-  bool converged = false;       ///< stopped on the tolerance, not on the iteration cap
-  bool fell_back = false;       ///< returned the given pose unchanged
-  std::string message;          ///< why it fell back, or empty
+  bool converged = false;                ///< stopped on the tolerance, not on the iteration cap
+  bool fell_back = false;                ///< returned the given pose unchanged
+  std::string message;                   ///< why it fell back, or empty
   std::vector<double> object_residuals;  ///< normalised W2 per match at the returned pose; -1 if not projectable
   std::vector<double> point_residuals;   ///< reprojection error in px per point; -1 if behind the camera
 };

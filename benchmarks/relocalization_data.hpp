@@ -1,0 +1,47 @@
+#pragma once
+// Loads the fr2_desk keyframe benchmark: map, camera, and per keyframe its box observations
+// and pose (the keyframe poses of the SLAM run that built the map).
+
+#include <string>
+#include <vector>
+
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/map.hpp"
+#include "ellreloc/io/trajectory.hpp"
+#include "ellreloc/observe/observation.hpp"
+
+namespace ellreloc::bench {
+
+struct Query {
+  std::string timestamp;
+  std::vector<Observation> observations;
+  Pose truth;
+};
+
+struct RelocalizationDataset {
+  ObjectMap map;
+  Intrinsics K;
+  std::vector<Query> queries;
+};
+
+inline RelocalizationDataset loadFr2Desk(const std::string& data_dir) {
+  RelocalizationDataset d;
+  const std::string dir = data_dir + "/tum_fr2_desk/";
+  d.map = io::readMap(dir + "map.json");
+  d.K = io::readCamera(dir + "camera.yaml");
+  const auto poses = io::readTumTrajectory(dir + "keyframes.groundtruth.txt");
+  for (const DetectionFrame& f : io::readDetections(dir + "keyframes.detections.json")) {
+    const auto k = io::findNearest(poses, f.timestamp().value_or(-1.0));
+    if (!k) continue;
+    Query q{f.timestampText(), {}, poses[*k].pose};
+    for (const Detection& det : f.detections) {
+      if (auto o = observationFromBox(det.category_id, det.score, det.bbox, d.K.width, d.K.height))
+        q.observations.push_back(*o);
+    }
+    d.queries.push_back(std::move(q));
+  }
+  return d;
+}
+
+}  // namespace ellreloc::bench

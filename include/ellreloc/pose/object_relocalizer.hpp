@@ -1,0 +1,131 @@
+#pragma once
+/// \file object_relocalizer.hpp
+/// Camera relocalization from one image's object observations and a map of ellipsoids: the
+/// paper's "initial pose recovery" (a P3P loop over ellipse-ellipsoid correspondences) and
+/// "pose refinement" (Wasserstein), as one call.
+///
+/// Hypotheses are triplets of (observation, map object) pairs of equal category. P3P on the
+/// observed ellipse centres and the ellipsoid centres gives up to four poses; the P3P input is
+/// then corrected for the offset between the centre of a projected ellipsoid's ellipse and the
+/// projection of its centre, and solved again. Each pose is scored by projecting the map and
+/// matching projections to observations one to one (same category, greedy on overlap) with a
+/// truncated cost sum_i min(1 - overlap_i, 1 - min_overlap): bounded, so a wrong or missed
+/// detection costs at most a constant. The best few distinct hypotheses are refined with the
+/// Wasserstein refiner on all their inliers and rescored.
+
+#include <string>
+#include <vector>
+
+#include "ellreloc/core/camera.hpp"
+#include "ellreloc/core/object_map.hpp"
+#include "ellreloc/observe/observation.hpp"
+#include "ellreloc/pose/ransac.hpp"
+#include "ellreloc/pose/wasserstein_refiner.hpp"
+
+namespace ellreloc {
+
+enum class HypothesisSampler {
+  Auto,        ///< Exhaustive when there are at most `max_exhaustive_triplets` triplets, else Prosac
+  Exhaustive,  ///< every triplet of candidate pairs (OA-SLAM)
+  Uniform,     ///< random triplets
+  Prosac,      ///< random triplets, best (detection score x object size) first
+};
+
+enum class OverlapMeasure {
+  EllipseIoU,  ///< IoU of the observed ellipse and the projected ellipse
+  BoxIoU,      ///< IoU of the observed box and the projected ellipse's bounding box (OA-SLAM)
+};
+
+struct RelocalizerOptions {
+  HypothesisSampler sampler = HypothesisSampler::Auto;
+  long max_exhaustive_triplets = 1000;
+  OverlapMeasure overlap = OverlapMeasure::EllipseIoU;
+  double min_overlap = 0.25;  ///< a match below this overlap is no match (the cost's truncation)
+  /// An object is a candidate for an observation of category c when at least this share of
+  /// its mapped detections carried c (MapObject::categoryShare): detectors confuse cups with
+  /// mice and books with plants, and maps that keep a label histogram know it. With no
+  /// histogram only equal categories match. Above 0.5, only the majority label matches.
+  double min_category_share = 0.05;
+  int min_inliers = 3;          ///< fewer matched observations: no consistent hypothesis
+  bool correct_centres = true;  ///< re-solve P3P with the projected-centre offset removed
+  int refine_top_k = 3;         ///< distinct hypotheses refined with the Wasserstein refiner
+  bool refine = true;
+  RefinerOptions refiner;
+  RansacOptions ransac;  ///< budgets, adaptive stopping, seed
+
+  RelocalizerOptions() {
+    ransac.min_iterations = 50;
+    ransac.max_iterations = 20000;
+    ransac.max_hypotheses = 50000;
+    ransac.max_time_ms = 0.0;  // a time budget makes results depend on the machine: off by default
+    ransac.success_probability = 0.999;
+    ransac.refine = false;  // the relocalizer refines its top hypotheses itself
+  }
+
+  /// OA-SLAM's relocalization as a baseline: every detection triplet against every object
+  /// triplet of equal categories, P3P on box centres, box-IoU scoring, no refinement. Give it
+  /// box-inscribed observations (observationFromBox).
+  static RelocalizerOptions oaSlam() {
+    RelocalizerOptions o;
+    o.sampler = HypothesisSampler::Exhaustive;
+    o.overlap = OverlapMeasure::BoxIoU;
+    o.correct_centres = false;
+    o.min_category_share = 1.0;  // equal (majority) categories only
+    o.refine = false;
+    o.refine_top_k = 1;
+    o.ransac.min_iterations = 1 << 30;  // enumerate everything, no adaptive stop
+    o.ransac.max_iterations = 1 << 30;
+    o.ransac.max_hypotheses = 1L << 40;
+    o.ransac.max_time_ms = 0.0;
+    return o;
+  }
+};
+
+enum class RelocalizationStatus {
+  Success,
+  NotEnoughObservations,   ///< fewer than three usable observations with a candidate object
+  NoConsistentHypothesis,  ///< no pose explains at least min_inliers observations
+};
+
+const char* toString(RelocalizationStatus s);
+
+struct ObjectCorrespondence {
+  int observation = 0;   ///< index into the observations given
+  int object = 0;        ///< index into map.objects
+  double overlap = 0.0;  ///< at the returned pose
+};
+
+struct RelocalizationResult {
+  RelocalizationStatus status = RelocalizationStatus::NotEnoughObservations;
+  std::string reason;  ///< human-readable, one line
+  Pose pose;           ///< valid when status == Success
+  std::vector<ObjectCorrespondence> inliers;
+  double cost = 0.0;                                 ///< truncated overlap cost of the pose (lower is better)
+  double mean_overlap = 0.0;                         ///< over the inliers
+  std::vector<std::pair<int, std::string>> skipped;  ///< observations not used, with the reason
+  long hypotheses = 0;
+  int iterations = 0;
+  bool budget_exhausted = false;
+  bool refined = false;
+  double time_ms = 0.0;
+};
+
+/// Holds a map and intrinsics; relocalize() is const and keeps no state, so one relocalizer
+/// can serve many threads at once.
+class ObjectRelocalizer {
+ public:
+  ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options = {});
+
+  RelocalizationResult relocalize(const std::vector<Observation>& observations) const;
+
+  const ObjectMap& map() const { return map_; }
+  const Intrinsics& intrinsics() const { return K_; }
+  const RelocalizerOptions& options() const { return options_; }
+
+ private:
+  ObjectMap map_;
+  Intrinsics K_;
+  RelocalizerOptions options_;
+};
+
+}  // namespace ellreloc

@@ -1,0 +1,354 @@
+#include "ellreloc/pose/object_relocalizer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/pose/p3p.hpp"
+
+namespace ellreloc {
+
+const char* toString(RelocalizationStatus s) {
+  switch (s) {
+    case RelocalizationStatus::Success:
+      return "success";
+    case RelocalizationStatus::NotEnoughObservations:
+      return "not enough observations";
+    case RelocalizationStatus::NoConsistentHypothesis:
+      return "no consistent hypothesis";
+  }
+  return "unknown";
+}
+
+namespace {
+
+/// Vertices of the polygon used by ellipseIoU while scoring hypotheses: IoU error ~1e-2,
+/// ample to rank poses, and twice as fast as the default 128.
+constexpr int kScoringIoUVertices = 48;
+
+struct CandidatePair {
+  int obs;
+  int obj;
+  double quality;  // detection score x apparent object size: PROSAC order
+};
+
+struct Match {
+  int obs;
+  int obj;
+  double overlap;
+};
+
+/// Scores poses: projects the relevant map objects and matches them to the observations.
+/// Holds per-call scratch buffers, so one Scorer must not be shared between threads.
+class Scorer {
+ public:
+  Scorer(const std::vector<Observation>& obs, const std::vector<char>& obs_valid,
+         const std::vector<std::vector<int>>& candidates_of_obs, const ObjectMap& map, const Intrinsics& K,
+         const RelocalizerOptions& opt)
+      : obs_(obs), obs_valid_(obs_valid), cands_(candidates_of_obs), map_(map), K_(K), opt_(opt) {
+    std::vector<char> relevant(map.objects.size(), 0);
+    for (const auto& c : cands_)
+      for (int j : c) relevant[j] = 1;
+    for (size_t j = 0; j < relevant.size(); ++j)
+      if (relevant[j]) relevant_.push_back(static_cast<int>(j));
+    proj_.resize(map.objects.size());
+    proj_ok_.resize(map.objects.size(), 0);
+    obs_used_.resize(obs.size());
+    obj_used_.resize(map.objects.size());
+    matches_.reserve(64);
+    for (size_t i = 0; i < obs.size(); ++i) num_valid_ += obs_valid[i] ? 1 : 0;
+  }
+
+  /// Truncated cost of a pose; fills the one-to-one matches when asked.
+  double cost(const Pose& pose, int vertices, std::vector<Match>* out = nullptr) const {
+    for (int j : relevant_) {
+      const Projection p = project(map_.objects[j].ellipsoid, K_, pose);
+      proj_ok_[j] = p.ok();
+      if (p.ok()) proj_[j] = p.ellipse;
+    }
+    matches_.clear();
+    for (size_t i = 0; i < obs_.size(); ++i) {
+      if (!obs_valid_[i]) continue;
+      const Observation& o = obs_[i];
+      for (int j : cands_[i]) {
+        if (!proj_ok_[j]) continue;
+        const Box pb = proj_[j].boundingBox();
+        if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
+        const double overlap =
+            opt_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, pb) : ellipseIoU(o.ellipse, proj_[j], vertices);
+        if (overlap >= opt_.min_overlap) matches_.push_back({static_cast<int>(i), j, overlap});
+      }
+    }
+    std::sort(matches_.begin(), matches_.end(), [](const Match& a, const Match& b) {
+      return a.overlap != b.overlap ? a.overlap > b.overlap : (a.obs != b.obs ? a.obs < b.obs : a.obj < b.obj);
+    });
+    std::fill(obs_used_.begin(), obs_used_.end(), 0);
+    std::fill(obj_used_.begin(), obj_used_.end(), 0);
+    const double miss = 1.0 - opt_.min_overlap;
+    double total = miss * num_valid_;
+    if (out) out->clear();
+    for (const Match& m : matches_) {
+      if (obs_used_[m.obs] || obj_used_[m.obj]) continue;
+      obs_used_[m.obs] = obj_used_[m.obj] = 1;
+      total += (1.0 - m.overlap) - miss;
+      if (out) out->push_back(m);
+    }
+    return total;
+  }
+
+  int numValid() const { return num_valid_; }
+
+ private:
+  const std::vector<Observation>& obs_;
+  const std::vector<char>& obs_valid_;
+  const std::vector<std::vector<int>>& cands_;
+  const ObjectMap& map_;
+  const Intrinsics& K_;
+  const RelocalizerOptions& opt_;
+  std::vector<int> relevant_;
+  int num_valid_ = 0;
+  mutable std::vector<Ellipse> proj_;
+  mutable std::vector<char> proj_ok_;
+  mutable std::vector<Match> matches_;
+  mutable std::vector<char> obs_used_, obj_used_;
+};
+
+struct Hypothesis {
+  double cost;
+  Pose pose;
+};
+
+/// RANSAC estimator over candidate pairs (see ransac.hpp for the concept).
+struct PairEstimator {
+  using Model = Pose;
+  static constexpr int kSampleSize = 3;
+  static constexpr int kMaxModels = 4;
+
+  const std::vector<CandidatePair>& pairs;
+  const std::vector<Observation>& obs;
+  const ObjectMap& map;
+  const Intrinsics& K;
+  const RelocalizerOptions& opt;
+  const Scorer& scorer;
+  mutable std::vector<Hypothesis> top;  // best distinct hypotheses, ascending cost
+
+  size_t numData() const { return pairs.size(); }
+
+  int generate(const int* s, Model* models) const {
+    const CandidatePair& a = pairs[s[0]];
+    const CandidatePair& b = pairs[s[1]];
+    const CandidatePair& c = pairs[s[2]];
+    if (a.obs == b.obs || a.obs == c.obs || b.obs == c.obs || a.obj == b.obj || a.obj == c.obj || b.obj == c.obj)
+      return 0;
+    const int ob[3] = {a.obs, b.obs, c.obs};
+    const int oj[3] = {a.obj, b.obj, c.obj};
+    std::array<Eigen::Vector3d, 3> bearings, centres;
+    for (int k = 0; k < 3; ++k) {
+      bearings[k] = K.bearing(obs[ob[k]].ellipse.center());
+      centres[k] = map.objects[oj[k]].ellipsoid.center();
+    }
+    std::array<Pose, 4> poses;
+    const int n = p3p(bearings, centres, &poses);
+    int count = 0;
+    for (int i = 0; i < n; ++i) {
+      Pose pose = poses[i];
+      if (opt.correct_centres && !correctCentres(ob, oj, &pose)) continue;
+      bool visible = true;
+      for (int k = 0; k < 3 && visible; ++k) visible = project(map.objects[oj[k]].ellipsoid, K, pose).ok();
+      if (visible) models[count++] = pose;
+    }
+    return count;
+  }
+
+  /// The centre of a projected ellipsoid's image is not the image of its centre: remove that
+  /// offset (measured at the current pose) from the observed centres and solve P3P again.
+  bool correctCentres(const int* ob, const int* oj, Pose* pose) const {
+    std::array<Eigen::Vector3d, 3> bearings, centres;
+    for (int k = 0; k < 3; ++k) {
+      const Ellipsoid& e = map.objects[oj[k]].ellipsoid;
+      const Projection p = project(e, K, *pose);
+      if (!p) return false;
+      const Eigen::Vector2d offset = p.ellipse.center() - K.project(pose->transform(e.center()));
+      bearings[k] = K.bearing(obs[ob[k]].ellipse.center() - offset);
+      centres[k] = e.center();
+    }
+    std::array<Pose, 4> poses;
+    const int n = p3p(bearings, centres, &poses);
+    double best = 1e9;
+    for (int i = 0; i < n; ++i) {
+      const double d = rotationErrorDeg(poses[i].rotation(), pose->rotation()) * M_PI / 180.0 +
+                       (poses[i].center() - pose->center()).norm();
+      if (d < best) best = d, *pose = poses[i];
+    }
+    return n > 0;
+  }
+
+  double score(const Model& pose, int* inliers) const {
+    thread_local std::vector<Match> matches;
+    const double c = scorer.cost(pose, kScoringIoUVertices, &matches);
+    *inliers = static_cast<int>(matches.size());
+    remember(c, pose);
+    return c;
+  }
+
+  void refine(Model*) const {}
+
+  /// Keeps the refine_top_k best hypotheses, one per pose neighbourhood.
+  void remember(double cost, const Pose& pose) const {
+    const size_t k = static_cast<size_t>(std::max(1, opt.refine_top_k));
+    if (top.size() == k && cost >= top.back().cost) return;
+    for (Hypothesis& h : top) {
+      if ((h.pose.center() - pose.center()).norm() < 0.05 &&
+          rotationErrorDeg(h.pose.rotation(), pose.rotation()) < 3.0) {
+        if (cost < h.cost) h = {cost, pose};
+        std::sort(top.begin(), top.end(), [](const Hypothesis& x, const Hypothesis& y) { return x.cost < y.cost; });
+        return;
+      }
+    }
+    top.push_back({cost, pose});
+    std::sort(top.begin(), top.end(), [](const Hypothesis& x, const Hypothesis& y) { return x.cost < y.cost; });
+    if (top.size() > k) top.pop_back();
+  }
+};
+
+}  // namespace
+
+ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
+    : map_(std::move(map)), K_(K), options_(std::move(options)) {}
+
+RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations) const {
+  const auto start = std::chrono::steady_clock::now();
+  RelocalizationResult result;
+  const auto finish = [&](RelocalizationStatus status, std::string reason) {
+    result.status = status;
+    result.reason = std::move(reason);
+    result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  };
+  if (!K_.isValid()) return finish(RelocalizationStatus::NotEnoughObservations, "invalid intrinsics");
+
+  // Usable observations and their candidate objects (same category).
+  std::vector<char> valid(observations.size(), 0);
+  std::vector<std::vector<int>> candidates(observations.size());
+  std::vector<CandidatePair> pairs;
+  int usable = 0;
+  for (size_t i = 0; i < observations.size(); ++i) {
+    const Observation& o = observations[i];
+    if (!o.ellipse.isValid() || !o.box.isValid() || !std::isfinite(o.score)) {
+      result.skipped.emplace_back(static_cast<int>(i), "invalid ellipse, box or score (NaN, infinite or empty)");
+      continue;
+    }
+    for (size_t j = 0; j < map_.objects.size(); ++j) {
+      const MapObject& m = map_.objects[j];
+      const double share =
+          m.category == o.category ? std::max(m.categoryShare(o.category), 0.5) : m.categoryShare(o.category);
+      if (!m.ellipsoid.isValid() || !(share >= std::min(options_.min_category_share, 0.5) &&
+                                      (m.category == o.category || share >= options_.min_category_share)))
+        continue;
+      candidates[i].push_back(static_cast<int>(j));
+      // Likelier labels, surer detections and larger objects first: PROSAC order.
+      pairs.push_back({static_cast<int>(i), static_cast<int>(j), share * o.score * std::cbrt(m.ellipsoid.volume())});
+    }
+    if (candidates[i].empty()) {
+      result.skipped.emplace_back(static_cast<int>(i), "no map object of category " + std::to_string(o.category));
+      continue;
+    }
+    valid[i] = 1;
+    ++usable;
+  }
+  if (usable < 3)
+    return finish(RelocalizationStatus::NotEnoughObservations,
+                  std::to_string(usable) + " usable observation(s) with a candidate object; 3 are needed");
+
+  std::stable_sort(pairs.begin(), pairs.end(),
+                   [](const CandidatePair& a, const CandidatePair& b) { return a.quality > b.quality; });
+  const Scorer scorer(observations, valid, candidates, map_, K_, options_);
+  const PairEstimator estimator{pairs, observations, map_, K_, options_, scorer, {}};
+  RansacOptions ropt = options_.ransac;
+  const int n = static_cast<int>(pairs.size());
+  HypothesisSampler sampler = options_.sampler;
+  if (sampler == HypothesisSampler::Auto) {
+    const double triplets = static_cast<double>(n) * (n - 1) * (n - 2) / 6.0;
+    sampler = triplets <= options_.max_exhaustive_triplets ? HypothesisSampler::Exhaustive : HypothesisSampler::Prosac;
+  }
+  if (sampler == HypothesisSampler::Exhaustive) {
+    // Small enough to try everything: the budgets still bound it.
+    ropt.min_iterations = std::max(ropt.min_iterations, std::numeric_limits<int>::max() / 2);
+    ropt.max_iterations = std::max(ropt.max_iterations, std::numeric_limits<int>::max() / 2);
+  }
+  Pose best;
+  RansacStats stats;
+  bool found = false;
+  switch (sampler) {
+    case HypothesisSampler::Auto:  // resolved above
+    case HypothesisSampler::Exhaustive: {
+      ExhaustiveSampler s(n, 3);
+      found = ransac(estimator, s, ropt, &best, &stats);
+      break;
+    }
+    case HypothesisSampler::Uniform: {
+      UniformSampler s(n, 3, ropt.seed);
+      found = ransac(estimator, s, ropt, &best, &stats);
+      break;
+    }
+    case HypothesisSampler::Prosac: {
+      // Reach uniform sampling over all pairs within ~1000 samples: the MSAC stopping rule
+      // assumes samples from all the data, and a wrong early model must not end the search
+      // while good pairs of lower quality are still out of reach.
+      ProsacSampler s(n, 3, ropt.seed, 1000);
+      found = ransac(estimator, s, ropt, &best, &stats);
+      break;
+    }
+  }
+  result.hypotheses = stats.hypotheses;
+  result.iterations = stats.iterations;
+  result.budget_exhausted = stats.budget_exhausted;
+  if (!found)
+    return finish(RelocalizationStatus::NoConsistentHypothesis, "no triplet gave a pose with the objects in view");
+
+  // Refine the best distinct hypotheses on all their matches; keep what scores best.
+  std::vector<Match> matches;
+  double best_cost = scorer.cost(best, 128, &matches);
+  for (const Hypothesis& h : estimator.top) {
+    Pose candidate = h.pose;
+    bool refined = false;
+    double cost = scorer.cost(candidate, 128, &matches);
+    if (options_.refine && static_cast<int>(matches.size()) >= 2) {
+      std::vector<EllipseMatch> em;
+      for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
+      const RefinementResult r = refinePose(K_, candidate, em, {}, options_.refiner);
+      if (!r.fell_back) {
+        const double refined_cost = scorer.cost(r.pose, 128);
+        if (refined_cost <= cost) {
+          candidate = r.pose;
+          cost = refined_cost;
+          refined = true;
+        }
+      }
+    }
+    if (cost < best_cost || (refined && cost <= best_cost)) {
+      best_cost = cost;
+      best = candidate;
+      result.refined = refined;
+    }
+  }
+  const double final_cost = scorer.cost(best, 128, &matches);
+  result.pose = best;
+  result.cost = final_cost;
+  double sum = 0.0;
+  for (const Match& m : matches) {
+    result.inliers.push_back({m.obs, m.obj, m.overlap});
+    sum += m.overlap;
+  }
+  result.mean_overlap = matches.empty() ? 0.0 : sum / matches.size();
+  if (static_cast<int>(matches.size()) < options_.min_inliers)
+    return finish(RelocalizationStatus::NoConsistentHypothesis, "best pose explains " + std::to_string(matches.size()) +
+                                                                    " observation(s); " +
+                                                                    std::to_string(options_.min_inliers) + " needed");
+  return finish(RelocalizationStatus::Success, "");
+}
+
+}  // namespace ellreloc

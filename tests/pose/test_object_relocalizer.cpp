@@ -1,0 +1,187 @@
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "../random_geometry.hpp"
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+
+using namespace ellreloc;
+using ellreloc::test::uniform;
+
+namespace {
+
+/// A room-sized map of n objects with categories drawn from `categories`, and a camera that
+/// sees most of them. Observations are the exact projections (plus optional noise).
+struct Synthetic {
+  ObjectMap map;
+  Pose truth;
+  std::vector<Observation> observations;
+  std::vector<int> object_of;  // ground-truth object index of each observation
+};
+
+Synthetic makeScene(std::mt19937& rng, int n, int categories, double centre_noise_px = 0.0) {
+  const Intrinsics K = test::testIntrinsics();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Synthetic s;
+  for (int i = 0; i < n; ++i) {
+    const double yaw = uniform(rng, -M_PI, M_PI);
+    s.map.objects.push_back({i, i % categories, "",
+                             Ellipsoid({uniform(rng, -1.2, 1.2), uniform(rng, -1.2, 1.2), uniform(rng, -0.3, 0.3)},
+                                       {uniform(rng, 0.05, 0.25), uniform(rng, 0.05, 0.25), uniform(rng, 0.05, 0.25)},
+                                       Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix())});
+  }
+  s.truth = test::randomLookAtPose(rng);
+  for (int j = 0; j < n; ++j) {
+    const Projection p = project(s.map.objects[j].ellipsoid, K, s.truth);
+    if (!p) continue;
+    const Box b = p.ellipse.boundingBox();
+    if (b.x1 < 0 || b.y1 < 0 || b.x2 > K.width || b.y2 > K.height) continue;
+    Observation o;
+    o.category = s.map.objects[j].category;
+    o.ellipse = Ellipse(p.ellipse.center() + centre_noise_px * Eigen::Vector2d(normal(rng), normal(rng)),
+                        p.ellipse.axes(), p.ellipse.angle());
+    o.box = o.ellipse.boundingBox();
+    o.source = EllipseSource::Given;
+    s.observations.push_back(o);
+    s.object_of.push_back(j);
+  }
+  return s;
+}
+
+double positionError(const Pose& a, const Pose& b) { return (a.center() - b.center()).norm(); }
+
+}  // namespace
+
+TEST(ObjectRelocalizer, RecoversThePoseAndTheCorrespondences) {
+  std::mt19937 rng(81);
+  const Intrinsics K = test::testIntrinsics();
+  int tried = 0, recovered = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Synthetic s = makeScene(rng, 12, 6, 0.5);
+    if (s.observations.size() < 4) continue;
+    ++tried;
+    const ObjectRelocalizer reloc(s.map, K);
+    const RelocalizationResult r = reloc.relocalize(s.observations);
+    ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
+    // 0.5 px of centre noise on ellipses of 10-50 px: about 1 cm and 0.2 degrees.
+    if (positionError(r.pose, s.truth) < 0.05 && rotationErrorDeg(r.pose.rotation(), s.truth.rotation()) < 1.0) {
+      ++recovered;
+      for (const ObjectCorrespondence& c : r.inliers) EXPECT_EQ(c.object, s.object_of[c.observation]);
+      EXPECT_GE(r.inliers.size(), s.observations.size() - 1);
+    }
+  }
+  EXPECT_GE(tried, 30);
+  EXPECT_GE(recovered, tried - 1);
+}
+
+TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
+  std::mt19937 rng(82);
+  const Intrinsics K = test::testIntrinsics();
+  int tried = 0, recovered = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    const Synthetic s = makeScene(rng, 25, 1, 0.5);  // 25 cups
+    if (s.observations.size() < 5) continue;
+    ++tried;
+    RelocalizerOptions opt;
+    opt.ransac.seed = trial;
+    const RelocalizationResult r = ObjectRelocalizer(s.map, K, opt).relocalize(s.observations);
+    EXPECT_LE(r.hypotheses, opt.ransac.max_hypotheses + 4);
+    recovered += r.status == RelocalizationStatus::Success && positionError(r.pose, s.truth) < 0.05;
+  }
+  EXPECT_GE(tried, 5);
+  EXPECT_GE(recovered, tried - 1);
+}
+
+TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
+  std::mt19937 rng(83);
+  const Intrinsics K = test::testIntrinsics();
+  Synthetic s = makeScene(rng, 12, 6);
+  while (s.observations.size() < 5) s = makeScene(rng, 12, 6);
+  const ObjectRelocalizer reloc(s.map, K);
+  // Fewer than three observations.
+  const std::vector<Observation> two(s.observations.begin(), s.observations.begin() + 2);
+  EXPECT_EQ(reloc.relocalize(two).status, RelocalizationStatus::NotEnoughObservations);
+  EXPECT_EQ(reloc.relocalize({}).status, RelocalizationStatus::NotEnoughObservations);
+  // No map object of the observed categories.
+  std::vector<Observation> unknown = s.observations;
+  for (auto& o : unknown) o.category = 999;
+  const RelocalizationResult ru = reloc.relocalize(unknown);
+  EXPECT_EQ(ru.status, RelocalizationStatus::NotEnoughObservations);
+  EXPECT_EQ(ru.skipped.size(), unknown.size());
+  EXPECT_NE(ru.skipped[0].second.find("no map object of category 999"), std::string::npos);
+  // NaN and degenerate observations are skipped with a reason; the rest still works.
+  std::vector<Observation> bad = s.observations;
+  Observation nan_obs = bad[0];
+  nan_obs.ellipse = Ellipse({std::nan(""), 10}, {5, 5}, 0);
+  Observation flat = bad[1];
+  flat.ellipse = Ellipse({10, 10}, {5, 0}, 0);
+  bad.push_back(nan_obs);
+  bad.push_back(flat);
+  const RelocalizationResult rb = reloc.relocalize(bad);
+  EXPECT_EQ(rb.status, RelocalizationStatus::Success);
+  ASSERT_EQ(rb.skipped.size(), 2u);
+  EXPECT_EQ(rb.skipped[0].first, static_cast<int>(bad.size()) - 2);
+  EXPECT_LT(positionError(rb.pose, s.truth), 0.02);
+  // Invalid intrinsics.
+  EXPECT_EQ(ObjectRelocalizer(s.map, Intrinsics()).relocalize(s.observations).status,
+            RelocalizationStatus::NotEnoughObservations);
+}
+
+TEST(ObjectRelocalizer, DeterministicAndThreadSafe) {
+  std::mt19937 rng(84);
+  const Intrinsics K = test::testIntrinsics();
+  std::vector<Synthetic> scenes;
+  while (scenes.size() < 8) {
+    Synthetic s = makeScene(rng, 30, 3, 1.0);  // large enough to use PROSAC, not enumeration
+    if (s.observations.size() >= 6) scenes.push_back(s);
+  }
+  // One map shared by all scenes: use the first scene's map and reproject for each pose.
+  const ObjectRelocalizer reloc(scenes[0].map, K);
+  std::vector<std::vector<Observation>> queries;
+  for (const Synthetic& s : scenes) {
+    std::vector<Observation> q;
+    for (const MapObject& m : scenes[0].map.objects) {
+      const Projection p = project(m.ellipsoid, K, s.truth);
+      if (!p) continue;
+      Observation o;
+      o.category = m.category;
+      o.ellipse = p.ellipse;
+      o.box = p.ellipse.boundingBox();
+      q.push_back(o);
+    }
+    queries.push_back(q);
+  }
+  std::vector<RelocalizationResult> serial;
+  for (const auto& q : queries) serial.push_back(reloc.relocalize(q));
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const RelocalizationResult again = reloc.relocalize(queries[i]);
+    EXPECT_EQ(again.pose.rotation(), serial[i].pose.rotation());
+    EXPECT_EQ(again.pose.translation(), serial[i].pose.translation());
+  }
+  std::vector<RelocalizationResult> parallel(queries.size());
+  std::vector<std::thread> threads;
+  for (size_t i = 0; i < queries.size(); ++i)
+    threads.emplace_back([&, i] { parallel[i] = reloc.relocalize(queries[i]); });
+  for (auto& t : threads) t.join();
+  for (size_t i = 0; i < queries.size(); ++i) {
+    EXPECT_EQ(parallel[i].status, serial[i].status);
+    EXPECT_EQ(parallel[i].pose.rotation(), serial[i].pose.rotation());
+    EXPECT_EQ(parallel[i].pose.translation(), serial[i].pose.translation());
+    EXPECT_EQ(parallel[i].hypotheses, serial[i].hypotheses);
+  }
+}
+
+TEST(ObjectRelocalizer, OaSlamPresetAlsoWorksOnBoxes) {
+  std::mt19937 rng(85);
+  const Intrinsics K = test::testIntrinsics();
+  Synthetic s = makeScene(rng, 10, 5);
+  while (s.observations.size() < 5) s = makeScene(rng, 10, 5);
+  std::vector<Observation> boxes;
+  for (const Observation& o : s.observations)
+    boxes.push_back(*observationFromBox(o.category, 1.0, o.ellipse.boundingBox(), K.width, K.height));
+  const RelocalizationResult r = ObjectRelocalizer(s.map, K, RelocalizerOptions::oaSlam()).relocalize(boxes);
+  ASSERT_EQ(r.status, RelocalizationStatus::Success);
+  EXPECT_FALSE(r.refined);
+  EXPECT_LT(positionError(r.pose, s.truth), 0.3);
+}
