@@ -1,50 +1,64 @@
-// The smallest useful program: a built-in scene of six objects, the image ellipses a camera
-// sees of them, and how the Wasserstein distance between observation and projection grows
-// as the camera pose is perturbed (what the relocalizer's refinement minimises).
-#include <ellreloc/core.hpp>
-
+// The library calls behind relocalization, for one frame.
+//   ellreloc_minimal                                 a built-in scene of eight objects
+//   ellreloc_minimal camera.yaml map.json detections.json   the first frame of your data
 #include <cstdio>
+#include <ellreloc/core.hpp>
+#include <ellreloc/io/camera.hpp>
+#include <ellreloc/io/detections.hpp>
+#include <ellreloc/io/map.hpp>
+#include <ellreloc/pose/object_relocalizer.hpp>
 
-int main() {
-  using namespace ellreloc;
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  const auto yaw = [](double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); };
-  // Objects on a 0.75 m table (world z up): monitor, keyboard, cup, book, bottle, chair.
-  const Ellipsoid scene[] = {
-      {{0.0, 0.3, 1.0}, {0.28, 0.04, 0.2}, yaw(0.1)},  {{0.0, 0.0, 0.77}, {0.22, 0.07, 0.015}, yaw(-0.05)},
-      {{0.35, 0.05, 0.8}, {0.04, 0.04, 0.05}, I},      {{-0.4, 0.1, 0.77}, {0.12, 0.09, 0.02}, yaw(0.6)},
-      {{0.5, 0.35, 0.86}, {0.035, 0.035, 0.11}, I},    {{0.1, -0.6, 0.45}, {0.25, 0.25, 0.45}, yaw(0.3)}};
-  // A camera 1.5 m in front of the table at eye height, looking at it.
-  Eigen::Matrix3d R_wc;
-  R_wc.col(2) = Eigen::Vector3d(0.0, 1.4, -0.6).normalized();                   // optical axis
-  R_wc.col(0) = R_wc.col(2).cross(Eigen::Vector3d::UnitZ()).normalized();       // image x
-  R_wc.col(1) = R_wc.col(2).cross(R_wc.col(0));                                 // image y (down)
-  const Pose truth = Pose::fromCameraToWorld(R_wc, {0.0, -1.5, 1.4});
-  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+using namespace ellreloc;
 
-  std::printf("object  centre (px)        semi-axes (px)   angle (deg)\n");
-  std::vector<std::pair<const Ellipsoid*, Ellipse>> observed;  // (object, its image)
-  for (const Ellipsoid& e : scene) {
-    const Projection p = project(e, K, truth);
-    if (!p) {
-      std::printf("  not visible: %s\n", toString(p.status));
-      continue;
-    }
-    observed.emplace_back(&e, p.ellipse);
-    const Ellipse& el = p.ellipse;
-    std::printf("%4zu   (%6.1f, %6.1f)   (%5.1f, %5.1f)   %6.1f\n", observed.size() - 1, el.center()(0), el.center()(1),
-                el.axes()(0), el.axes()(1), el.angle() * 180.0 / M_PI);
+int main(int argc, char** argv) try {
+  Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  ObjectMap map;
+  std::vector<Observation> observations;
+  if (argc == 4) {
+    K = io::readCamera(argv[1]);
+    map = io::readMap(argv[2]);
+    for (const Detection& d : io::readDetections(argv[3]).at(0).detections)
+      if (auto o = observationFromBox(d.category_id, d.score, d.bbox, K.width, K.height)) observations.push_back(*o);
+  } else {
+    // Objects on and around a desk (world z up), COCO ids: tv 62, keyboard 66, cup 41, book 73,
+    // bottle 39, chair 56, laptop 63, mouse 64.
+    const auto yaw = [](double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); };
+    const std::pair<int, Ellipsoid> desk[] = {{62, {{0.0, 0.3, 1.0}, {0.28, 0.04, 0.2}, yaw(0.1)}},
+                                              {66, {{0.0, 0.0, 0.77}, {0.22, 0.07, 0.015}, yaw(-0.05)}},
+                                              {41, {{0.35, 0.05, 0.8}, {0.04, 0.04, 0.05}, yaw(0)}},
+                                              {73, {{-0.4, 0.1, 0.77}, {0.12, 0.09, 0.02}, yaw(0.6)}},
+                                              {39, {{0.5, 0.35, 0.86}, {0.035, 0.035, 0.11}, yaw(0)}},
+                                              {56, {{0.1, -0.6, 0.45}, {0.25, 0.25, 0.45}, yaw(0.3)}},
+                                              {63, {{-0.6, 0.35, 0.85}, {0.17, 0.12, 0.1}, yaw(-0.4)}},
+                                              {64, {{0.3, -0.1, 0.77}, {0.03, 0.05, 0.02}, yaw(0.2)}}};
+    for (const auto& [category, e] : desk)
+      map.objects.push_back({static_cast<int>(map.objects.size()), category, "", e});
+    // What a detector sees from a camera 1.5 m in front of the desk: one box per object.
+    Eigen::Matrix3d R_wc;
+    R_wc.col(2) = Eigen::Vector3d(0.3, 1.4, -0.6).normalized();              // optical axis
+    R_wc.col(0) = R_wc.col(2).cross(Eigen::Vector3d::UnitZ()).normalized();  // image x
+    R_wc.col(1) = R_wc.col(2).cross(R_wc.col(0));                            // image y, down
+    const Pose truth = Pose::fromCameraToWorld(R_wc, {-0.4, -1.5, 1.4});
+    for (const MapObject& m : map.objects)
+      if (const Projection p = project(m.ellipsoid, K, truth))
+        observations.push_back(*observationFromBox(m.category, 0.9, p.ellipse.boundingBox(), K.width, K.height));
+    std::printf("true camera centre: %.3f %.3f %.3f\n", truth.center()(0), truth.center()(1), truth.center()(2));
   }
-  std::printf("\nrotation error -> mean W2 between observations and projections (px)\n");
-  for (double deg : {0.0, 0.5, 1.0, 2.0, 5.0}) {
-    const Pose moved(Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix() * truth.rotation(),
-                     truth.translation());
-    double sum = 0.0;
-    for (const auto& [object, image] : observed) {
-      const Projection p = project(*object, K, moved);
-      sum += p ? wasserstein2(image, p.ellipse) : 1e3;  // a lost object costs a large constant
-    }
-    std::printf("  %4.1f deg -> %7.2f\n", deg, sum / observed.size());
+
+  const ObjectRelocalizer relocalizer(map, K);
+  const RelocalizationResult r = relocalizer.relocalize(observations);
+  if (r.status != RelocalizationStatus::Success) {
+    std::printf("not relocalized: %s (%s)\n", toString(r.status), r.reason.c_str());
+    return 1;
   }
+  const Eigen::Vector3d c = r.pose.center();
+  std::printf("camera centre:      %.3f %.3f %.3f\n", c(0), c(1), c(2));
+  std::printf("%zu of %zu observations matched, %ld hypotheses, %.2f ms\n", r.inliers.size(), observations.size(),
+              r.hypotheses, r.time_ms);
+  for (const ObjectCorrespondence& m : r.inliers)
+    std::printf("  observation %d -> object %d (IoU %.2f)\n", m.observation, map.objects[m.object].id, m.overlap);
   return 0;
+} catch (const Error& e) {
+  std::fprintf(stderr, "ellreloc_minimal: %s\n", e.what());
+  return 2;
 }

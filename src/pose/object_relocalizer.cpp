@@ -137,6 +137,11 @@ struct PairEstimator {
 
   size_t numData() const { return pairs.size(); }
 
+  double overlap(const Observation& o, const Ellipse& projected) const {
+    return opt.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, projected.boundingBox())
+                                                 : ellipseIoU(o.ellipse, projected, kScoringIoUVertices);
+  }
+
   int generate(const int* s, Model* models) const {
     const CandidatePair& a = pairs[s[0]];
     const CandidatePair& b = pairs[s[1]];
@@ -157,7 +162,10 @@ struct PairEstimator {
       Pose pose = poses[i];
       if (opt.correct_centres && !correctCentres(ob, oj, &pose)) continue;
       bool visible = true;
-      for (int k = 0; k < 3 && visible; ++k) visible = project(map.objects[oj[k]].ellipsoid, K, pose).ok();
+      for (int k = 0; k < 3 && visible; ++k) {
+        const Projection p = project(map.objects[oj[k]].ellipsoid, K, pose);
+        visible = p.ok() && (!opt.check_sample_overlap || overlap(obs[ob[k]], p.ellipse) >= opt.min_overlap);
+      }
       if (visible) models[count++] = pose;
     }
     return count;

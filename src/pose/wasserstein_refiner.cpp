@@ -63,7 +63,7 @@ struct Problem {
       const Projection p = project(objects[i]->ellipsoid, K, pose);
       if (!p) return false;
       const double s = wasserstein2Squared(objects[i]->observed, p.ellipse) / (object_scale[i] * object_scale[i]);
-      double rho, drho;
+      double rho = 0.0, drho = 0.0;
       loss(opt.object_loss, opt.object_loss_scale, s, &rho, &drho);
       sum += rho;
     }
@@ -71,7 +71,7 @@ struct Problem {
       const Eigen::Vector3d x = pose.transform(m.point);
       if (!(x(2) > 0.0)) return false;
       const double s = (K.project(x) - m.observed).squaredNorm() / (opt.point_sigma_px * opt.point_sigma_px);
-      double rho, drho;
+      double rho = 0.0, drho = 0.0;
       loss(opt.point_loss, opt.point_loss_scale, s, &rho, &drho);
       sum += opt.point_weight * rho;
     }
@@ -83,20 +83,42 @@ struct Problem {
   bool normalEquations(const Pose& pose, Mat6* H, Vec6* g) const {
     H->setZero();
     g->setZero();
+    // M(delta) = [Exp(omega) | v] maps the current camera frame to the perturbed one. At
+    // delta = 0, C*(delta) = K M Qc M^T K^T has value K Qc[0:3,0:3] K^T and derivatives
+    // dC/dd_k = G_k + G_k^T with G_k = K E_k N, N = Qc[:, 0:3] K^T and E_k = dM/dd_k:
+    // [[e_k]x | 0] for omega_k, [0 | e_k] for v_k. Seeding C* as a Jet with these
+    // derivatives is exact and much cheaper than pushing Jets through the 4x4 products.
+    const Eigen::Matrix3d Kd = K.K();
     Jet delta[6];
     for (int k = 0; k < 6; ++k) delta[k] = Jet(0.0, k);
-    // M(delta) = [Exp(omega) | v], applied to camera-frame quantities of the current pose.
-    Jet Rj[9];
-    ceres::AngleAxisToRotationMatrix(delta, ceres::RowMajorAdapter3x3(Rj));
     Eigen::Matrix<Jet, 3, 4> M;
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) M(r, c) = Rj[3 * r + c];
+      for (int c = 0; c < 3; ++c) M(r, c) = Jet(r == c ? 1.0 : 0.0);
       M(r, 3) = delta[3 + r];
     }
-    const Eigen::Matrix<Jet, 3, 4> KM = K.K().cast<Jet>() * M;
+    M(0, 1) = -delta[2], M(0, 2) = delta[1], M(1, 0) = delta[2], M(1, 2) = -delta[0], M(2, 0) = -delta[1],
+         M(2, 1) = delta[0];  // first-order Exp(omega) = I + [omega]x: exact for the derivative
     for (size_t i = 0; i < objects.size(); ++i) {
       const Eigen::Matrix4d Qc = cameraDualQuadric(objects[i]->ellipsoid, pose);
-      const Mat3<Jet> C = projectDualQuadric<Jet>(KM, Qc.cast<Jet>());
+      const Eigen::Matrix<double, 4, 3> N = Qc.leftCols<3>() * Kd.transpose();
+      const Eigen::Matrix3d C0 = Kd * N.topRows<3>();
+      Mat3<Jet> C;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) C(r, c) = Jet(C0(r, c));
+      for (int k = 0; k < 6; ++k) {
+        Eigen::Matrix3d EN;  // E_k N
+        if (k < 3) {
+          const Eigen::Vector3d e = Eigen::Vector3d::Unit(k);
+          for (int c = 0; c < 3; ++c) EN.col(c) = e.cross(N.block<3, 1>(0, c));
+        } else {
+          EN.setZero();
+          EN.row(k - 3) = N.row(3);
+        }
+        const Eigen::Matrix3d G = Kd * EN;
+        const Eigen::Matrix3d dC = G + G.transpose();
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) C(r, c).v(k) = dC(r, c);
+      }
       Vec2<Jet> mean;
       Mat2<Jet> cov;
       gaussianFromDualConic<Jet>(C, &mean, &cov);
@@ -110,7 +132,7 @@ struct Problem {
         J.row(k) = r[k].v.transpose() / object_scale[i];
       }
       if (!J.allFinite() || !res.allFinite()) return false;
-      double rho, drho;
+      double rho = 0.0, drho = 0.0;
       loss(opt.object_loss, opt.object_loss_scale, res.squaredNorm(), &rho, &drho);
       *H += drho * J.transpose() * J;
       *g += drho * J.transpose() * res;
@@ -123,7 +145,7 @@ struct Problem {
       Eigen::Vector2d res((u.a - m.observed(0)) / opt.point_sigma_px, (v.a - m.observed(1)) / opt.point_sigma_px);
       J.row(0) = u.v.transpose() / opt.point_sigma_px;
       J.row(1) = v.v.transpose() / opt.point_sigma_px;
-      double rho, drho;
+      double rho = 0.0, drho = 0.0;
       loss(opt.point_loss, opt.point_loss_scale, res.squaredNorm(), &rho, &drho);
       *H += opt.point_weight * drho * J.transpose() * J;
       *g += opt.point_weight * drho * J.transpose() * res;

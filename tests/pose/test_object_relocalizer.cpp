@@ -79,7 +79,7 @@ TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
   std::mt19937 rng(82);
   const Intrinsics K = test::testIntrinsics();
   int tried = 0, recovered = 0;
-  for (int trial = 0; trial < 10; ++trial) {
+  for (int trial = 0; trial < 6; ++trial) {
     const Synthetic s = makeScene(rng, 25, 1, 0.5);  // 25 cups
     if (s.observations.size() < 5) continue;
     ++tried;
@@ -89,7 +89,7 @@ TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
     EXPECT_LE(r.hypotheses, opt.ransac.max_hypotheses + 4);
     recovered += r.status == RelocalizationStatus::Success && positionError(r.pose, s.truth) < 0.05;
   }
-  EXPECT_GE(tried, 5);
+  EXPECT_GE(tried, 4);
   EXPECT_GE(recovered, tried - 1);
 }
 

@@ -48,7 +48,11 @@ struct RelocalizerOptions {
   double min_category_share = 0.05;
   int min_inliers = 3;          ///< fewer matched observations: no consistent hypothesis
   bool correct_centres = true;  ///< re-solve P3P with the projected-centre offset removed
-  int refine_top_k = 3;         ///< distinct hypotheses refined with the Wasserstein refiner
+  /// Drop a pose at once when one of its own three pairs overlaps less than min_overlap:
+  /// P3P fits the centres exactly, but a wrong triplet rarely fits the three shapes, and this
+  /// costs three overlaps instead of scoring the whole map.
+  bool check_sample_overlap = true;
+  int refine_top_k = 3;  ///< distinct hypotheses refined with the Wasserstein refiner
   bool refine = true;
   RefinerOptions refiner;
   RansacOptions ransac;  ///< budgets, adaptive stopping, seed
@@ -70,6 +74,7 @@ struct RelocalizerOptions {
     o.sampler = HypothesisSampler::Exhaustive;
     o.overlap = OverlapMeasure::BoxIoU;
     o.correct_centres = false;
+    o.check_sample_overlap = false;
     o.min_category_share = 1.0;  // equal (majority) categories only
     o.refine = false;
     o.refine_top_k = 1;
