@@ -57,30 +57,37 @@ inline int solveMonicCubic(double a, double b, double c, double roots[3], bool l
   return 1;
 }
 
-/// Eigen decomposition of a symmetric rank-2 matrix: eigenvectors e1, e2 for the non-zero
-/// eigenvalues s1, s2 (the third is 0). Returns false when the matrix is numerically rank < 2.
-inline bool eigenRank2(const Eigen::Matrix3d& D, Eigen::Vector3d* e1, Eigen::Vector3d* e2, double* s1, double* s2) {
-  // The non-zero eigenvalues from the trace and the sum of principal 2x2 minors.
-  const double tr = D.trace();
-  const double minors = D(0, 0) * D(1, 1) - D(0, 1) * D(1, 0) + D(0, 0) * D(2, 2) - D(0, 2) * D(2, 0) +
-                        D(1, 1) * D(2, 2) - D(1, 2) * D(2, 1);
-  const double disc = 0.25 * tr * tr - minors;
-  if (!(disc >= 0.0)) return false;
-  const double r = std::sqrt(disc);
-  *s1 = 0.5 * tr + r;
-  *s2 = 0.5 * tr - r;
-  // Eigenvector of s: the longest cross product of two rows of (D - s I), which has rank 2.
-  auto eigenvector = [&D](double s, Eigen::Vector3d* v) {
-    const Eigen::Matrix3d A = D - s * Eigen::Matrix3d::Identity();
-    const Eigen::Vector3d c0 = A.row(0).cross(A.row(1)), c1 = A.row(0).cross(A.row(2)), c2 = A.row(1).cross(A.row(2));
-    const double n0 = c0.squaredNorm(), n1 = c1.squaredNorm(), n2 = c2.squaredNorm();
-    const Eigen::Vector3d& best = n0 >= n1 && n0 >= n2 ? c0 : (n1 >= n2 ? c1 : c2);
-    const double n = std::sqrt(std::max({n0, n1, n2}));
-    if (!(n > 0.0)) return false;
-    *v = best / n;
-    return true;
-  };
-  return eigenvector(*s1, e1) && eigenvector(*s2, e2);
+/// Splits a degenerate quadric lambda^T D lambda = 0 (symmetric, rank 2, indefinite) into its
+/// two planes through the origin, D ~ l m^T + m l^T (Richter-Gebert, "Perspectives on
+/// Projective Geometry", sec. 11.3): adj(D) = -p p^T with p = l x m, and D + [p]x = 2 m l^T has
+/// rank one, so one of its rows is l and one of its columns m. False for a definite D (no
+/// real planes).
+inline bool splitPlanePair(const Eigen::Matrix3d& D, Eigen::Vector3d* l, Eigen::Vector3d* m) {
+  // Diagonal of the adjugate: the principal 2x2 minors.
+  const double b0 = D(1, 1) * D(2, 2) - D(1, 2) * D(2, 1);
+  const double b1 = D(0, 0) * D(2, 2) - D(0, 2) * D(2, 0);
+  const double b2 = D(0, 0) * D(1, 1) - D(0, 1) * D(1, 0);
+  int i = 0;
+  double bmin = b0;
+  if (b1 < bmin) i = 1, bmin = b1;
+  if (b2 < bmin) i = 2, bmin = b2;
+  if (!(bmin < 0.0)) return false;
+  const double beta = std::sqrt(-bmin);
+  // Column i of the adjugate, divided by beta: p up to sign.
+  Eigen::Vector3d p;
+  const int j = (i + 1) % 3, k = (i + 2) % 3;
+  p(i) = bmin;
+  p(j) = D(k, i) * D(j, k) - D(j, i) * D(k, k);
+  p(k) = D(j, i) * D(k, j) - D(k, i) * D(j, j);
+  p /= beta;
+  Eigen::Matrix3d A = D;
+  A(0, 1) -= p(2), A(0, 2) += p(1), A(1, 0) += p(2), A(1, 2) -= p(0), A(2, 0) -= p(1), A(2, 1) += p(0);
+  Eigen::Index r, c;
+  A.cwiseAbs().maxCoeff(&r, &c);
+  if (!(std::abs(A(r, c)) > 0.0)) return false;
+  *l = A.row(r).transpose();
+  *m = A.col(c);
+  return true;
 }
 
 }  // namespace detail
@@ -141,14 +148,11 @@ inline int p3p(const std::array<Eigen::Vector3d, 3>& bearings, const std::array<
     }
     for (int g = pass; g < n_gamma && count == 0; ++g) {
       const Eigen::Matrix3d D0 = std::isinf(gammas[g]) ? D2 : Eigen::Matrix3d(D1 + gammas[g] * D2);
-      Eigen::Vector3d e1, e2;
-      double s1, s2;
-      if (!detail::eigenRank2(D0, &e1, &e2, &s1, &s2) || !(s1 * s2 < 0.0)) continue;
+      Eigen::Vector3d planes[2];
+      if (!detail::splitPlanePair(D0, &planes[0], &planes[1])) continue;
       // On the planes of D0, D1 = -gamma D2: use the larger of the two as the remaining quadric.
       const Eigen::Matrix3d& Dq = std::abs(gammas[g]) > 1.0 ? D1 : D2;
-      const double s = std::sqrt(-s2 / s1);
-      for (int sign = -1; sign <= 1; sign += 2) {
-        const Eigen::Vector3d n = e1 + sign * s * e2;  // plane normal: n . lambda = 0
+      for (const Eigen::Vector3d& n : planes) {  // plane normal: n . lambda = 0
         if (!(std::abs(n(0)) > 1e-10 * n.norm())) continue;
         const double w0 = -n(1) / n(0), w1 = -n(2) / n(0);
         // lambda = lambda3 (w0 tau + w1, tau, 1) = lambda3 (p tau + r)
