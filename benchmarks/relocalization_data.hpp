@@ -20,6 +20,7 @@ struct Query {
 };
 
 struct RelocalizationDataset {
+  std::string name;
   ObjectMap map;
   Intrinsics K;
   std::vector<Query> queries;
@@ -27,6 +28,7 @@ struct RelocalizationDataset {
 
 inline RelocalizationDataset loadFr2Desk(const std::string& data_dir) {
   RelocalizationDataset d;
+  d.name = "fr2_desk keyframes";
   const std::string dir = data_dir + "/tum_fr2_desk/";
   d.map = io::readMap(dir + "map.json");
   d.K = io::readCamera(dir + "camera.yaml");

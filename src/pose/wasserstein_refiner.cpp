@@ -1,5 +1,6 @@
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
+#include <ceres/ceres.h>
 #include <ceres/jet.h>
 #include <ceres/rotation.h>
 
@@ -162,6 +163,105 @@ Pose applyDelta(const Pose& pose, const Vec6& d) {
   return Pose(nearestRotation(dR * pose.rotation()), dR * pose.translation() + d.tail<3>());
 }
 
+/// Ceres cost of one ellipse-ellipsoid match: the normalised 6-vector W2 residual at the pose
+/// (quaternion x, y, z, w; translation). A pose that puts the ellipsoid across the principal
+/// plane is rejected (returns false), so Ceres shortens the step.
+struct CeresObjectCost {
+  CeresObjectCost(const Ellipse& observed, const Ellipsoid& e, const Intrinsics& K, double scale)
+      : mean(observed.center()),
+        cov(observed.covariance()),
+        Q(e.dualQuadric()),
+        M(e.shapeMatrix()),
+        c(e.center()),
+        K(K.K()),
+        inv_scale(1.0 / scale) {}
+  template <typename T>
+  bool operator()(const T* q, const T* t, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> quat(q);
+    const Mat3<T> R = quat.normalized().toRotationMatrix();
+    const Eigen::Matrix<T, 3, 1> tt(t[0], t[1], t[2]);
+    // Depth range of the ellipsoid: it must stay strictly in front of the camera.
+    const Eigen::Matrix<T, 3, 1> r3 = R.row(2).transpose();
+    using std::sqrt;
+    const T zc = r3.dot(c.cast<T>()) + tt(2);
+    const T half = sqrt(r3.dot(M.cast<T>() * r3));
+    if (!(zc - half > T(0))) return false;
+    Eigen::Matrix<T, 3, 4> P;
+    P << R, tt;
+    P = K.cast<T>() * P;
+    const Mat3<T> C = projectDualQuadric<T>(P, Q.cast<T>());
+    Vec2<T> m;
+    Mat2<T> S;
+    gaussianFromDualConic<T>(C, &m, &S);
+    wasserstein2Residual<T>(mean.cast<T>(), cov.cast<T>(), m, S, r);
+    for (int k = 0; k < 6; ++k) r[k] *= T(inv_scale);
+    return true;
+  }
+  Eigen::Vector2d mean;
+  Eigen::Matrix2d cov;
+  Eigen::Matrix4d Q;
+  Eigen::Matrix3d M;
+  Eigen::Vector3d c;
+  Eigen::Matrix3d K;
+  double inv_scale;
+};
+
+struct CeresPointCost {
+  CeresPointCost(const PointMatch& m, const Intrinsics& K, double sigma) : m(m), K(K), inv_sigma(1.0 / sigma) {}
+  template <typename T>
+  bool operator()(const T* q, const T* t, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> quat(q);
+    const Eigen::Matrix<T, 3, 1> x = quat.normalized() * m.point.cast<T>() + Eigen::Matrix<T, 3, 1>(t[0], t[1], t[2]);
+    if (!(x(2) > T(0))) return false;
+    r[0] = (T(K.fx) * x(0) / x(2) + T(K.cx) - T(m.observed(0))) * T(inv_sigma);
+    r[1] = (T(K.fy) * x(1) / x(2) + T(K.cy) - T(m.observed(1))) * T(inv_sigma);
+    return true;
+  }
+  PointMatch m;
+  Intrinsics K;
+  double inv_sigma;
+};
+
+ceres::LossFunction* makeLoss(RobustLoss type, double scale, double weight) {
+  ceres::LossFunction* loss = nullptr;
+  if (type == RobustLoss::Huber) loss = new ceres::HuberLoss(scale);
+  if (type == RobustLoss::Cauchy) loss = new ceres::CauchyLoss(scale);
+  if (weight != 1.0) loss = new ceres::ScaledLoss(loss, weight, ceres::TAKE_OWNERSHIP);
+  return loss;
+}
+
+/// Minimises the same cost as Problem with Ceres; returns the pose and the iteration count.
+Pose solveWithCeres(const Problem& problem, const Pose& initial, const RefinerOptions& opt, int* iterations,
+                    bool* converged) {
+  Eigen::Quaterniond q(initial.rotation());
+  Eigen::Vector3d t = initial.translation();
+  ceres::Problem::Options popt;
+  ceres::Problem cp(popt);
+  for (size_t i = 0; i < problem.objects.size(); ++i) {
+    auto* cost = new ceres::AutoDiffCostFunction<CeresObjectCost, 6, 4, 3>(new CeresObjectCost(
+        problem.objects[i]->observed, problem.objects[i]->ellipsoid, problem.K, problem.object_scale[i]));
+    cp.AddResidualBlock(cost, makeLoss(opt.object_loss, opt.object_loss_scale, 1.0), q.coeffs().data(), t.data());
+  }
+  for (const PointMatch& m : problem.points) {
+    auto* cost =
+        new ceres::AutoDiffCostFunction<CeresPointCost, 2, 4, 3>(new CeresPointCost(m, problem.K, opt.point_sigma_px));
+    cp.AddResidualBlock(cost, makeLoss(opt.point_loss, opt.point_loss_scale, opt.point_weight), q.coeffs().data(),
+                        t.data());
+  }
+  cp.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = opt.max_iterations;
+  so.function_tolerance = opt.function_tolerance;
+  so.logging_type = ceres::SILENT;
+  so.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &cp, &summary);
+  *iterations = static_cast<int>(summary.iterations.size());
+  *converged = summary.termination_type == ceres::CONVERGENCE;
+  return Pose(nearestRotation(q.normalized().toRotationMatrix()), t);
+}
+
 }  // namespace
 
 RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std::vector<EllipseMatch>& objects,
@@ -205,6 +305,23 @@ RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std:
     return result;
   }
   result.initial_cost = cost;
+  if (options.backend == RefinerBackend::Ceres) {
+    bool converged = false;
+    const Pose refined = solveWithCeres(problem, initial, options, &result.iterations, &converged);
+    double refined_cost = 0.0;
+    // Ceres' cost is ours times 1/2; compare with ours, and never return a worse pose.
+    if (refined.isValid() && problem.cost(refined, &refined_cost) && refined_cost <= cost) {
+      result.pose = refined;
+      result.final_cost = refined_cost;
+      result.converged = converged;
+      result.fell_back = false;
+    } else {
+      result.final_cost = cost;
+      result.message = "the solver ended at a higher cost; returning the initial pose";
+    }
+    fillResiduals(result);
+    return result;
+  }
   Pose pose = initial;
   double lambda = 1e-4;
   for (int it = 0; it < options.max_iterations; ++it) {

@@ -171,3 +171,21 @@ TEST(WassersteinRefiner, DegenerateInputIsHandled) {
   const RefinementResult rb = refinePose(K, s.truth, bad);
   EXPECT_EQ(rb.object_residuals.back(), -1.0);
 }
+
+TEST(WassersteinRefiner, CeresBackendReachesTheSameMinimum) {
+  std::mt19937 rng(75);
+  const Intrinsics K = test::testIntrinsics();
+  RefinerOptions ceres_opt;
+  ceres_opt.backend = RefinerBackend::Ceres;
+  int agree = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Scene s = makeScene(rng, 4 + trial % 8, 1.0, 0.02, trial % 2 ? 30 : 0);
+    const Pose start = perturb(rng, s.truth, 5.0, 0.1);
+    const RefinementResult ours = refinePose(K, start, s.matches, s.points);
+    const RefinementResult cer = refinePose(K, start, s.matches, s.points, ceres_opt);
+    EXPECT_LE(cer.final_cost, cer.initial_cost);
+    EXPECT_NEAR(cer.initial_cost, ours.initial_cost, 1e-9 * ours.initial_cost);
+    agree += positionError(ours.pose, cer.pose) < 1e-3 && rotationError(ours.pose, cer.pose) < 0.02;
+  }
+  EXPECT_GE(agree, 38);
+}

@@ -8,10 +8,13 @@
 /// 200-px monitor that are both off by 10% of their size weigh alike. Optional keypoint
 /// reprojection residuals (the paper's "objects + points") join the same problem.
 ///
-/// Solved by Levenberg-Marquardt on a left perturbation of the pose, derivatives by forward
-/// automatic differentiation (Ceres Jets), robust losses by iteratively reweighted least
-/// squares. A step is accepted only when the robust cost decreases, so the returned pose never
-/// has a higher cost than the one given.
+/// The default backend is Levenberg-Marquardt on a left perturbation of the pose, derivatives
+/// by forward automatic differentiation (Ceres Jets) seeded analytically, robust losses by
+/// iteratively reweighted least squares; a step is accepted only when the robust cost
+/// decreases. The Ceres backend builds a ceres::Problem (quaternion on
+/// EigenQuaternionManifold, translation in R^3, ceres::HuberLoss / CauchyLoss). Either way the
+/// returned pose never has a higher cost than the one given: if it would, the given pose is
+/// returned and `fell_back` says so.
 
 #include <string>
 #include <vector>
@@ -24,7 +27,14 @@ namespace ellreloc {
 
 enum class RobustLoss { None, Huber, Cauchy };
 
+/// Which solver minimises the cost; both use the same residuals and losses.
+enum class RefinerBackend {
+  LevenbergMarquardt,  ///< our 6-DoF solver with analytically seeded Jets (the faster: default)
+  Ceres,               ///< ceres::Problem with EigenQuaternionManifold x R^3 and autodiff
+};
+
 struct RefinerOptions {
+  RefinerBackend backend = RefinerBackend::LevenbergMarquardt;
   RobustLoss object_loss = RobustLoss::Cauchy;
   double object_loss_scale = 0.5;  ///< in normalised W2 units (W2 / sqrt(a b))
   RobustLoss point_loss = RobustLoss::Huber;
