@@ -1,0 +1,181 @@
+#pragma once
+/// \file mask.hpp
+/// Binary instance masks: decoding COCO run-length masks, boundary points and moments.
+/// Header-only, no OpenCV.
+
+#include "ellreloc/core/box.hpp"
+#include "ellreloc/observe/rle.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace ellreloc {
+
+/// A row-major 0/1 mask.
+struct BinaryMask {
+  int height = 0;
+  int width = 0;
+  std::vector<uint8_t> data;
+
+  BinaryMask() = default;
+  BinaryMask(int h, int w) : height(h), width(w), data(static_cast<size_t>(h) * static_cast<size_t>(w), 0) {}
+
+  uint8_t at(int x, int y) const { return data[static_cast<size_t>(y) * width + x]; }
+  uint8_t& at(int x, int y) { return data[static_cast<size_t>(y) * width + x]; }
+  bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width && y < height; }
+  long count() const {
+    long n = 0;
+    for (uint8_t v : data) n += v != 0;
+    return n;
+  }
+};
+
+/// Decodes a COCO run-length mask (column-major runs starting with zeros). nullopt when its
+/// runs do not add up to height x width.
+inline std::optional<BinaryMask> decodeMask(const RleMask& rle) {
+  if (!rle.isConsistent()) return std::nullopt;
+  BinaryMask m(rle.height, rle.width);
+  uint64_t pos = 0;
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    if (i % 2 == 1) {
+      for (uint64_t k = pos; k < pos + rle.counts[i]; ++k) {
+        const int x = static_cast<int>(k / rle.height), y = static_cast<int>(k % rle.height);
+        m.at(x, y) = 1;
+      }
+    }
+    pos += rle.counts[i];
+  }
+  return m;
+}
+
+/// Encodes a mask as COCO run lengths.
+inline RleMask encodeMask(const BinaryMask& m) {
+  RleMask rle;
+  rle.height = m.height;
+  rle.width = m.width;
+  uint8_t current = 0;
+  uint32_t run = 0;
+  for (int x = 0; x < m.width; ++x) {
+    for (int y = 0; y < m.height; ++y) {
+      const uint8_t v = m.at(x, y) ? 1 : 0;
+      if (v != current) {
+        rle.counts.push_back(run);
+        run = 0;
+        current = v;
+      }
+      ++run;
+    }
+  }
+  rle.counts.push_back(run);
+  return rle;
+}
+
+/// First and second moments of a mask's pixels, each pixel a unit square centred on its
+/// integer coordinates.
+struct MaskMoments {
+  double area = 0.0;  ///< pixel count
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  Box bounds;  ///< outer pixel edges of the mask, FORMATS convention
+};
+
+/// Moments straight from the runs, without decoding: a run of ones in column x from y0 to y1
+/// adds n = y1 - y0 + 1 pixels with known sums of y and y^2. O(number of runs).
+inline std::optional<MaskMoments> rleMoments(const RleMask& rle) {
+  if (!rle.isConsistent()) return std::nullopt;
+  long double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+  double x1 = 1e300, y1 = 1e300, x2 = -1e300, y2 = -1e300;
+  uint64_t pos = 0;
+  const uint64_t h = static_cast<uint64_t>(rle.height);
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    uint64_t start = pos, remaining = rle.counts[i];
+    pos += rle.counts[i];
+    if (i % 2 == 0) continue;
+    while (remaining > 0) {  // a run may continue into the next columns
+      const long double x = static_cast<long double>(start / h);
+      const uint64_t y0 = start % h;
+      const uint64_t len = std::min<uint64_t>(remaining, h - y0);
+      const long double a = static_cast<long double>(y0), b = static_cast<long double>(y0 + len - 1);
+      const long double cnt = static_cast<long double>(len);
+      const long double sum_y = cnt * (a + b) / 2;
+      const long double sum_y2 = (b * (b + 1) * (2 * b + 1) - (a - 1) * a * (2 * a - 1)) / 6;
+      n += cnt;
+      sx += cnt * x;
+      sxx += cnt * x * x;
+      sy += sum_y;
+      syy += sum_y2;
+      sxy += x * sum_y;
+      x1 = std::min(x1, static_cast<double>(x));
+      x2 = std::max(x2, static_cast<double>(x));
+      y1 = std::min(y1, static_cast<double>(a));
+      y2 = std::max(y2, static_cast<double>(b));
+      start += len;
+      remaining -= len;
+    }
+  }
+  if (n <= 0) return std::nullopt;
+  MaskMoments m;
+  m.area = static_cast<double>(n);
+  m.mean = Eigen::Vector2d(static_cast<double>(sx / n), static_cast<double>(sy / n));
+  // Pixel centres' covariance plus that of a unit square (1/12 on each axis).
+  m.covariance(0, 0) = static_cast<double>(sxx / n) - m.mean(0) * m.mean(0) + 1.0 / 12.0;
+  m.covariance(1, 1) = static_cast<double>(syy / n) - m.mean(1) * m.mean(1) + 1.0 / 12.0;
+  m.covariance(0, 1) = m.covariance(1, 0) = static_cast<double>(sxy / n) - m.mean(0) * m.mean(1);
+  m.bounds = Box(x1 - 0.5, y1 - 0.5, x2 + 0.5, y2 + 0.5);
+  return m;
+}
+
+/// Points on the outer outline of a mask: the midpoints of the pixel edges between a mask
+/// pixel and a background 4-neighbour connected to the outside (unbiased, unlike boundary pixel
+/// centres; holes do not count). Edges on the image border are dropped (truncated objects),
+/// and `touches_border` says whether there were any.
+inline std::vector<Eigen::Vector2d> maskOutline(const BinaryMask& m, bool* touches_border = nullptr) {
+  std::vector<Eigen::Vector2d> pts;
+  if (touches_border) *touches_border = false;
+  int x1 = m.width, y1 = m.height, x2 = -1, y2 = -1;
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < m.width; ++x)
+      if (m.at(x, y)) x1 = std::min(x1, x), x2 = std::max(x2, x), y1 = std::min(y1, y), y2 = std::max(y2, y);
+  if (x2 < 0) return pts;
+  // Background reachable from outside the bounding box (one-pixel frame), by flood fill.
+  const int w = x2 - x1 + 3, h = y2 - y1 + 3;
+  std::vector<uint8_t> outside(static_cast<size_t>(w) * h, 0);
+  auto mask_at = [&](int fx, int fy) {  // frame coordinates
+    const int x = fx + x1 - 1, y = fy + y1 - 1;
+    return m.inside(x, y) && m.at(x, y);
+  };
+  std::vector<int> stack = {0};
+  outside[0] = 1;
+  while (!stack.empty()) {
+    const int i = stack.back();
+    stack.pop_back();
+    const int fx = i % w, fy = i / w;
+    const int nx[4] = {fx + 1, fx - 1, fx, fx}, ny[4] = {fy, fy, fy + 1, fy - 1};
+    for (int k = 0; k < 4; ++k) {
+      if (nx[k] < 0 || ny[k] < 0 || nx[k] >= w || ny[k] >= h) continue;
+      const int j = ny[k] * w + nx[k];
+      if (!outside[j] && !mask_at(nx[k], ny[k])) outside[j] = 1, stack.push_back(j);
+    }
+  }
+  static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+  for (int y = y1; y <= y2; ++y) {
+    for (int x = x1; x <= x2; ++x) {
+      if (!m.at(x, y)) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int nx = x + dx[k], ny = y + dy[k];
+        if (!m.inside(nx, ny)) {
+          if (touches_border) *touches_border = true;
+          continue;
+        }
+        if (outside[static_cast<size_t>(ny - y1 + 1) * w + (nx - x1 + 1)]) pts.emplace_back(x + 0.5 * dx[k], y + 0.5 * dy[k]);
+      }
+    }
+  }
+  return pts;
+}
+
+}  // namespace ellreloc

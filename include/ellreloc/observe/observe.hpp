@@ -1,0 +1,59 @@
+#pragma once
+/// \file observe.hpp
+/// Turns a detection (box, optional mask or ellipse) into an observation ellipse, as the
+/// paper's relocalization does: a "regular" mask (a convex quadrilateral) gets an ellipse
+/// fitted to the mask, any other detection the ellipse inscribed in its box.
+
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/observe/observation.hpp"
+#include "ellreloc/observe/regular_mask.hpp"
+
+#include <optional>
+#include <string>
+
+namespace ellreloc {
+
+enum class ObservationPolicy {
+  Paper,  ///< regular mask -> mask fit, otherwise the box-inscribed ellipse
+  Bbox,   ///< always the box-inscribed ellipse (OA-SLAM)
+  Mask,   ///< fit the mask whenever there is one
+  Given,  ///< the detection's own `ellipse` field
+};
+
+/// How an ellipse is fitted to a mask.
+enum class MaskFitMethod {
+  Moments,       ///< same second moments as the mask (from the RLE runs, no decoding)
+  Direct,        ///< direct least squares on the outline, image-border points dropped
+  Quadrilateral, ///< regular masks: the projectively inscribed ellipse of the quadrilateral
+};
+
+struct ObserveOptions {
+  ObservationPolicy policy = ObservationPolicy::Paper;
+  MaskFitMethod regular_fit = MaskFitMethod::Quadrilateral;  ///< for regular masks
+  MaskFitMethod irregular_fit = MaskFitMethod::Direct;       ///< for other masks (policy Mask)
+  RegularMaskOptions regular;
+  double border_px = 2.0;  ///< a box this close to the image border is flagged truncated
+};
+
+enum class ObserveStatus {
+  Ok,
+  InvalidBox,        ///< NaN, empty, or wholly outside the image: no observation
+  NoEllipse,         ///< policy Given without an `ellipse`, or an invalid one: no observation
+};
+
+struct ObserveResult {
+  ObserveStatus status = ObserveStatus::InvalidBox;
+  std::optional<Observation> observation;
+  /// Why the mask was not used when the policy wanted it (size mismatch, empty mask, fit
+  /// failed); the observation then falls back to the box-inscribed ellipse.
+  std::string note;
+};
+
+/// Observes one detection of an image of width x height pixels.
+ObserveResult observeDetection(const Detection& detection, int width, int height, const ObserveOptions& options = {});
+
+/// Fits an ellipse to a mask with the given method; `verdict` is needed by Quadrilateral.
+std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, const BinaryMask& mask, MaskFitMethod method,
+                                      const RegularVerdict* verdict);
+
+}  // namespace ellreloc

@@ -1,0 +1,92 @@
+#include "ellreloc/observe/observe.hpp"
+
+#include "ellreloc/observe/ellipse_fit.hpp"
+
+#include <cmath>
+
+namespace ellreloc {
+
+std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, const BinaryMask& mask, MaskFitMethod method,
+                                      const RegularVerdict* verdict) {
+  switch (method) {
+    case MaskFitMethod::Moments: {
+      const auto m = rleMoments(rle);
+      return m ? momentEllipse(*m) : std::nullopt;
+    }
+    case MaskFitMethod::Direct:
+      return fitEllipseDirect(maskOutline(mask));
+    case MaskFitMethod::Quadrilateral:
+      if (!verdict || verdict->quad_vertices != 4) return std::nullopt;
+      return projectivelyInscribedEllipse(verdict->corners);
+  }
+  return std::nullopt;
+}
+
+ObserveResult observeDetection(const Detection& d, int width, int height, const ObserveOptions& opt) {
+  ObserveResult r;
+  const Box image(-0.5, -0.5, width - 0.5, height - 0.5);
+  if (!d.bbox.isValid() || !(d.bbox.width() > 0) || !(d.bbox.height() > 0) || !(d.bbox.intersection(image).area() > 0)) {
+    r.status = ObserveStatus::InvalidBox;
+    return r;
+  }
+  auto box_obs = observationFromBox(d.category_id, d.score, d.bbox, width, height, opt.border_px);
+  if (!box_obs) {
+    r.status = ObserveStatus::InvalidBox;
+    return r;
+  }
+  r.status = ObserveStatus::Ok;
+  Observation obs = *box_obs;
+  if (opt.policy == ObservationPolicy::Bbox) {
+    r.observation = obs;
+    return r;
+  }
+  if (opt.policy == ObservationPolicy::Given) {
+    if (!d.ellipse || !d.ellipse->isValid()) {
+      r.status = ObserveStatus::NoEllipse;
+      return r;
+    }
+    obs.ellipse = *d.ellipse;
+    obs.source = EllipseSource::Given;
+    r.observation = obs;
+    return r;
+  }
+  // Paper and Mask policies: use the mask when it is usable.
+  if (!d.mask) {
+    r.note = "no mask: box-inscribed ellipse";
+    r.observation = obs;
+    return r;
+  }
+  if (d.mask->height != height || d.mask->width != width) {
+    r.note = "mask size " + std::to_string(d.mask->height) + "x" + std::to_string(d.mask->width) +
+             " differs from the image " + std::to_string(height) + "x" + std::to_string(width) + ": box-inscribed ellipse";
+    r.observation = obs;
+    return r;
+  }
+  const auto mask = decodeMask(*d.mask);
+  if (!mask || mask->count() == 0) {
+    r.note = "empty or inconsistent mask: box-inscribed ellipse";
+    r.observation = obs;
+    return r;
+  }
+  const RegularVerdict verdict = testRegularMask(*mask, opt.regular);
+  obs.regular = verdict.regular;
+  obs.truncated = obs.truncated || verdict.touches_border;
+  if (opt.policy == ObservationPolicy::Paper && !verdict.regular) {
+    r.observation = obs;
+    return r;
+  }
+  const MaskFitMethod method = verdict.regular ? opt.regular_fit : opt.irregular_fit;
+  std::optional<Ellipse> fitted = fitMaskEllipse(*d.mask, *mask, method, &verdict);
+  if (!fitted && method != MaskFitMethod::Moments) fitted = fitMaskEllipse(*d.mask, *mask, MaskFitMethod::Moments, &verdict);
+  if (!fitted || !fitted->isValid()) {
+    r.note = "ellipse fit failed: box-inscribed ellipse";
+    r.observation = obs;
+    return r;
+  }
+  obs.ellipse = *fitted;
+  obs.source = EllipseSource::Mask;
+  r.observation = obs;
+  return r;
+}
+
+}  // namespace ellreloc
