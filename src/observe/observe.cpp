@@ -1,8 +1,8 @@
 #include "ellreloc/observe/observe.hpp"
 
-#include "ellreloc/observe/ellipse_fit.hpp"
-
 #include <cmath>
+
+#include "ellreloc/observe/ellipse_fit.hpp"
 
 namespace ellreloc {
 
@@ -25,7 +25,8 @@ std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, const BinaryMask& mask
 ObserveResult observeDetection(const Detection& d, int width, int height, const ObserveOptions& opt) {
   ObserveResult r;
   const Box image(-0.5, -0.5, width - 0.5, height - 0.5);
-  if (!d.bbox.isValid() || !(d.bbox.width() > 0) || !(d.bbox.height() > 0) || !(d.bbox.intersection(image).area() > 0)) {
+  if (!d.bbox.isValid() || !(d.bbox.width() > 0) || !(d.bbox.height() > 0) ||
+      !(d.bbox.intersection(image).area() > 0)) {
     r.status = ObserveStatus::InvalidBox;
     return r;
   }
@@ -58,7 +59,8 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   }
   if (d.mask->height != height || d.mask->width != width) {
     r.note = "mask size " + std::to_string(d.mask->height) + "x" + std::to_string(d.mask->width) +
-             " differs from the image " + std::to_string(height) + "x" + std::to_string(width) + ": box-inscribed ellipse";
+             " differs from the image " + std::to_string(height) + "x" + std::to_string(width) +
+             ": box-inscribed ellipse";
     r.observation = obs;
     return r;
   }
@@ -77,7 +79,8 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   }
   const MaskFitMethod method = verdict.regular ? opt.regular_fit : opt.irregular_fit;
   std::optional<Ellipse> fitted = fitMaskEllipse(*d.mask, *mask, method, &verdict);
-  if (!fitted && method != MaskFitMethod::Moments) fitted = fitMaskEllipse(*d.mask, *mask, MaskFitMethod::Moments, &verdict);
+  if (!fitted && method != MaskFitMethod::Moments)
+    fitted = fitMaskEllipse(*d.mask, *mask, MaskFitMethod::Moments, &verdict);
   if (!fitted || !fitted->isValid()) {
     r.note = "ellipse fit failed: box-inscribed ellipse";
     r.observation = obs;

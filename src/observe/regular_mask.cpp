@@ -1,8 +1,7 @@
 #include "ellreloc/observe/regular_mask.hpp"
 
-#include <opencv2/imgproc.hpp>
-
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 namespace ellreloc {
 
@@ -18,7 +17,8 @@ double pixelArea(const std::vector<cv::Point>& poly) {
 
 RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions& options) {
   RegularVerdict v;
-  if (mask.width <= 0 || mask.height <= 0 || mask.data.size() != static_cast<size_t>(mask.width) * mask.height) return v;
+  if (mask.width <= 0 || mask.height <= 0 || mask.data.size() != static_cast<size_t>(mask.width) * mask.height)
+    return v;
   // Work on the mask's bounding box (plus a one-pixel frame so contours close).
   int x1 = mask.width, y1 = mask.height, x2 = -1, y2 = -1;
   long area = 0;
@@ -50,11 +50,17 @@ RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions&
   v.quad_vertices = static_cast<int>(quad.size());
   if (quad.size() != 4) return v;
   v.fill = static_cast<double>(area) / pixelArea(quad);
+  // A noisy triangle can reach four corners first (one cut off); it is a triangle when three
+  // corners already enclose the mask as tightly as the regular range of fills allows.
+  std::vector<cv::Point> tri = quad;
+  for (double k = 0.005; tri.size() > 3 && k < 0.5; k *= 1.25) cv::approxPolyDP(hull, tri, k * perimeter, true);
+  if (tri.size() == 3) v.triangle_fill = static_cast<double>(area) / pixelArea(tri);
   v.min_corner_angle_deg = 180.0;
   for (int i = 0; i < 4; ++i) {
     const cv::Point2d p(quad[(i + 3) % 4]), c(quad[i]), n(quad[(i + 1) % 4]);
     const cv::Point2d a = p - c, b = n - c;
-    const double ang = std::acos(std::clamp(a.dot(b) / (std::hypot(a.x, a.y) * std::hypot(b.x, b.y) + 1e-12), -1.0, 1.0));
+    const double ang =
+        std::acos(std::clamp(a.dot(b) / (std::hypot(a.x, a.y) * std::hypot(b.x, b.y) + 1e-12), -1.0, 1.0));
     v.max_corner_angle_deg = std::max(v.max_corner_angle_deg, ang * 180.0 / M_PI);
     v.min_corner_angle_deg = std::min(v.min_corner_angle_deg, ang * 180.0 / M_PI);
     // Contours run through pixel centres: move the corner out so that both sides move out by
@@ -64,8 +70,9 @@ RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions&
     const cv::Point2d out = bn > 1e-9 ? bis * (0.5 / std::sin(0.5 * ang) / bn) : cv::Point2d(0, 0);
     v.corners[i] = Eigen::Vector2d(c.x + out.x + x1 - 1, c.y + out.y + y1 - 1);
   }
-  v.regular = v.solidity >= options.min_solidity && v.fill >= options.min_fill && v.fill <= options.max_fill &&
-              v.max_corner_angle_deg <= options.max_corner_angle_deg &&
+  const bool triangle = v.triangle_fill >= options.min_fill && v.triangle_fill <= options.max_fill;
+  v.regular = !triangle && v.solidity >= options.min_solidity && v.fill >= options.min_fill &&
+              v.fill <= options.max_fill && v.max_corner_angle_deg <= options.max_corner_angle_deg &&
               v.min_corner_angle_deg >= options.min_corner_angle_deg;
   return v;
 }

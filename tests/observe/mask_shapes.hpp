@@ -1,11 +1,11 @@
 #pragma once
 // Rasterised shapes for the observation tests: a pixel belongs to a shape when its centre does.
 
-#include "ellreloc/core/ellipse.hpp"
-#include "ellreloc/observe/mask.hpp"
-
 #include <random>
 #include <vector>
+
+#include "ellreloc/core/ellipse.hpp"
+#include "ellreloc/observe/mask.hpp"
 
 namespace ellreloc::test {
 

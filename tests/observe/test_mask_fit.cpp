@@ -1,15 +1,15 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "../data_dir.hpp"
+#include "../random_geometry.hpp"
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
 #include "ellreloc/observe/mask.hpp"
-
-#include "../data_dir.hpp"
-#include "../random_geometry.hpp"
 #include "mask_shapes.hpp"
-
-#include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
 
 using namespace ellreloc;
 using ellreloc::test::uniform;
@@ -132,8 +132,8 @@ TEST(EllipseFit, ProjectivelyInscribedEllipseIsTheImageOfTheRectanglesEllipse) {
     EXPECT_LT(wasserstein2(*e, p.ellipse), 1e-3 * p.ellipse.axes()(0)) << i;
     // Tangent to each side at the image of its midpoint.
     for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d mid = pose.transform(c + R * Eigen::Vector3d(0.5 * (sx[k] + sx[(k + 1) % 4]) * a,
-                                                                         0.5 * (sy[k] + sy[(k + 1) % 4]) * b, 0));
+      const Eigen::Vector3d mid = pose.transform(
+          c + R * Eigen::Vector3d(0.5 * (sx[k] + sx[(k + 1) % 4]) * a, 0.5 * (sy[k] + sy[(k + 1) % 4]) * b, 0));
       EXPECT_NEAR(e->mahalanobisRadius(K.project(mid)), 1.0, 1e-6);
     }
   }

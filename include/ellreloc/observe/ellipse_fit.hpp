@@ -4,14 +4,13 @@
 /// least-squares fit (Fitzgibbon, Pilu & Fisher 1999, in Halir & Flusser's numerically stable
 /// form, 1998), and the projectively inscribed ellipse of a quadrilateral. Eigen only.
 
-#include "ellreloc/core/ellipse.hpp"
-#include "ellreloc/observe/mask.hpp"
-
 #include <Eigen/Dense>
-
 #include <array>
 #include <optional>
 #include <vector>
+
+#include "ellreloc/core/ellipse.hpp"
+#include "ellreloc/observe/mask.hpp"
 
 namespace ellreloc {
 

@@ -3,15 +3,14 @@
 /// Binary instance masks: decoding COCO run-length masks, boundary points and moments.
 /// Header-only, no OpenCV.
 
-#include "ellreloc/core/box.hpp"
-#include "ellreloc/observe/rle.hpp"
-
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
+
+#include "ellreloc/core/box.hpp"
+#include "ellreloc/observe/rle.hpp"
 
 namespace ellreloc {
 
@@ -171,7 +170,8 @@ inline std::vector<Eigen::Vector2d> maskOutline(const BinaryMask& m, bool* touch
           if (touches_border) *touches_border = true;
           continue;
         }
-        if (outside[static_cast<size_t>(ny - y1 + 1) * w + (nx - x1 + 1)]) pts.emplace_back(x + 0.5 * dx[k], y + 0.5 * dy[k]);
+        if (outside[static_cast<size_t>(ny - y1 + 1) * w + (nx - x1 + 1)])
+          pts.emplace_back(x + 0.5 * dx[k], y + 0.5 * dy[k]);
       }
     }
   }

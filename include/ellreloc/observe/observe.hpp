@@ -4,12 +4,12 @@
 /// paper's relocalization does: a "regular" mask (a convex quadrilateral) gets an ellipse
 /// fitted to the mask, any other detection the ellipse inscribed in its box.
 
+#include <optional>
+#include <string>
+
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/observation.hpp"
 #include "ellreloc/observe/regular_mask.hpp"
-
-#include <optional>
-#include <string>
 
 namespace ellreloc {
 
@@ -22,9 +22,9 @@ enum class ObservationPolicy {
 
 /// How an ellipse is fitted to a mask.
 enum class MaskFitMethod {
-  Moments,       ///< same second moments as the mask (from the RLE runs, no decoding)
-  Direct,        ///< direct least squares on the outline, image-border points dropped
-  Quadrilateral, ///< regular masks: the projectively inscribed ellipse of the quadrilateral
+  Moments,        ///< same second moments as the mask (from the RLE runs, no decoding)
+  Direct,         ///< direct least squares on the outline, image-border points dropped
+  Quadrilateral,  ///< regular masks: the projectively inscribed ellipse of the quadrilateral
 };
 
 struct ObserveOptions {
@@ -37,8 +37,8 @@ struct ObserveOptions {
 
 enum class ObserveStatus {
   Ok,
-  InvalidBox,        ///< NaN, empty, or wholly outside the image: no observation
-  NoEllipse,         ///< policy Given without an `ellipse`, or an invalid one: no observation
+  InvalidBox,  ///< NaN, empty, or wholly outside the image: no observation
+  NoEllipse,   ///< policy Given without an `ellipse`, or an invalid one: no observation
 };
 
 struct ObserveResult {
