@@ -64,8 +64,8 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
     r.observation = obs;
     return r;
   }
-  const auto mask = decodeMask(*d.mask);
-  if (!mask || mask->count() == 0) {
+  const auto mask = decodeMaskCrop(*d.mask);  // only the object's box: cost follows the object
+  if (!mask) {
     r.note = "empty or inconsistent mask: box-inscribed ellipse";
     r.observation = obs;
     return r;

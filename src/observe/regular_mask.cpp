@@ -26,7 +26,8 @@ RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions&
     for (int x = 0; x < mask.width; ++x)
       if (mask.at(x, y)) x1 = std::min(x1, x), x2 = std::max(x2, x), y1 = std::min(y1, y), y2 = std::max(y2, y), ++area;
   if (area < options.min_pixels) return v;
-  v.touches_border = x1 == 0 || y1 == 0 || x2 == mask.width - 1 || y2 == mask.height - 1;
+  v.touches_border = x1 + mask.x0 == 0 || y1 + mask.y0 == 0 || x2 + mask.x0 == mask.image_width - 1 ||
+                     y2 + mask.y0 == mask.image_height - 1;
   cv::Mat roi = cv::Mat::zeros(y2 - y1 + 3, x2 - x1 + 3, CV_8U);
   for (int y = y1; y <= y2; ++y)
     for (int x = x1; x <= x2; ++x) roi.at<uint8_t>(y - y1 + 1, x - x1 + 1) = mask.at(x, y) ? 255 : 0;
@@ -68,7 +69,7 @@ RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions&
     const cv::Point2d bis = -(a / std::hypot(a.x, a.y) + b / std::hypot(b.x, b.y));
     const double bn = std::hypot(bis.x, bis.y);
     const cv::Point2d out = bn > 1e-9 ? bis * (0.5 / std::sin(0.5 * ang) / bn) : cv::Point2d(0, 0);
-    v.corners[i] = Eigen::Vector2d(c.x + out.x + x1 - 1, c.y + out.y + y1 - 1);
+    v.corners[i] = Eigen::Vector2d(c.x + out.x + x1 - 1 + mask.x0, c.y + out.y + y1 - 1 + mask.y0);
   }
   const bool triangle = v.triangle_fill >= options.min_fill && v.triangle_fill <= options.max_fill;
   v.regular = !triangle && v.solidity >= options.min_solidity && v.fill >= options.min_fill &&

@@ -170,3 +170,18 @@ TEST(EllipseFit, RealMasksAgreeWithOpenCvFitEllipse) {
     }
   }
 }
+
+TEST(Mask, CropDecodingMatchesFullDecoding) {
+  for (const auto& frame : io::readDetections(test::dataPath("labelme_masks/detections.json"))) {
+    for (const auto& det : frame.detections) {
+      const BinaryMask full = *decodeMask(*det.mask);
+      const BinaryMask crop = *decodeMaskCrop(*det.mask);
+      EXPECT_EQ(crop.count(), full.count());
+      EXPECT_EQ(encodeMask(crop).counts, det.mask->counts);
+      EXPECT_EQ(maskOutline(crop), maskOutline(full));
+      EXPECT_DOUBLE_EQ(crop.x0 - 0.5, det.bbox.x1);
+      EXPECT_DOUBLE_EQ(crop.y0 + crop.height - 0.5, det.bbox.y2);
+    }
+  }
+  EXPECT_FALSE(decodeMaskCrop(encodeMask(BinaryMask(10, 10))).has_value());  // empty
+}

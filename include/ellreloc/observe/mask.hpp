@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -14,14 +15,22 @@
 
 namespace ellreloc {
 
-/// A row-major 0/1 mask.
+/// A row-major 0/1 mask of width x height pixels. It may be a crop: then its pixel (0, 0) is
+/// pixel (x0, y0) of an image of image_width x image_height, and everything outside is 0.
 struct BinaryMask {
   int height = 0;
   int width = 0;
   std::vector<uint8_t> data;
+  int x0 = 0, y0 = 0;
+  int image_width = 0, image_height = 0;
 
   BinaryMask() = default;
-  BinaryMask(int h, int w) : height(h), width(w), data(static_cast<size_t>(h) * static_cast<size_t>(w), 0) {}
+  BinaryMask(int h, int w)
+      : height(h),
+        width(w),
+        data(static_cast<size_t>(h) * static_cast<size_t>(w), 0),
+        image_width(w),
+        image_height(h) {}
 
   uint8_t at(int x, int y) const { return data[static_cast<size_t>(y) * width + x]; }
   uint8_t& at(int x, int y) { return data[static_cast<size_t>(y) * width + x]; }
@@ -33,8 +42,8 @@ struct BinaryMask {
   }
 };
 
-/// Decodes a COCO run-length mask (column-major runs starting with zeros). nullopt when its
-/// runs do not add up to height x width.
+/// Decodes a COCO run-length mask (column-major runs starting with zeros) into a full-image
+/// mask. nullopt when its runs do not add up to height x width.
 inline std::optional<BinaryMask> decodeMask(const RleMask& rle) {
   if (!rle.isConsistent()) return std::nullopt;
   BinaryMask m(rle.height, rle.width);
@@ -51,16 +60,57 @@ inline std::optional<BinaryMask> decodeMask(const RleMask& rle) {
   return m;
 }
 
-/// Encodes a mask as COCO run lengths.
+/// Decodes only the bounding box of a run-length mask's pixels, as a crop (BinaryMask::x0, y0):
+/// the work is proportional to the object, not to the image. nullopt when inconsistent or empty.
+inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle) {
+  if (!rle.isConsistent()) return std::nullopt;
+  const uint64_t h = static_cast<uint64_t>(rle.height);
+  uint64_t pos = 0, first = std::numeric_limits<uint64_t>::max(), last = 0;
+  int ymin = rle.height, ymax = -1;
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    if (i % 2 == 1 && rle.counts[i] > 0) {
+      first = std::min(first, pos);
+      last = pos + rle.counts[i] - 1;
+      // A run within one column covers rows y0..y1; across columns it covers every row.
+      if (pos / h == last / h) {
+        ymin = std::min<int>(ymin, static_cast<int>(pos % h));
+        ymax = std::max<int>(ymax, static_cast<int>(last % h));
+      } else {
+        ymin = 0;
+        ymax = rle.height - 1;
+      }
+    }
+    pos += rle.counts[i];
+  }
+  if (first == std::numeric_limits<uint64_t>::max()) return std::nullopt;
+  const int xmin = static_cast<int>(first / h), xmax = static_cast<int>(last / h);
+  BinaryMask m(ymax - ymin + 1, xmax - xmin + 1);
+  m.x0 = xmin;
+  m.y0 = ymin;
+  m.image_width = rle.width;
+  m.image_height = rle.height;
+  pos = 0;
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    if (i % 2 == 1) {
+      for (uint64_t k = pos; k < pos + rle.counts[i]; ++k)
+        m.at(static_cast<int>(k / h) - xmin, static_cast<int>(k % h) - ymin) = 1;
+    }
+    pos += rle.counts[i];
+  }
+  return m;
+}
+
+/// Encodes a mask (of the whole image, for a crop) as COCO run lengths.
 inline RleMask encodeMask(const BinaryMask& m) {
   RleMask rle;
-  rle.height = m.height;
-  rle.width = m.width;
+  rle.height = m.image_height;
+  rle.width = m.image_width;
   uint8_t current = 0;
   uint32_t run = 0;
-  for (int x = 0; x < m.width; ++x) {
-    for (int y = 0; y < m.height; ++y) {
-      const uint8_t v = m.at(x, y) ? 1 : 0;
+  for (int x = 0; x < m.image_width; ++x) {
+    for (int y = 0; y < m.image_height; ++y) {
+      const int lx = x - m.x0, ly = y - m.y0;
+      const uint8_t v = m.inside(lx, ly) && m.at(lx, ly) ? 1 : 0;
       if (v != current) {
         rle.counts.push_back(run);
         run = 0;
@@ -166,12 +216,13 @@ inline std::vector<Eigen::Vector2d> maskOutline(const BinaryMask& m, bool* touch
       if (!m.at(x, y)) continue;
       for (int k = 0; k < 4; ++k) {
         const int nx = x + dx[k], ny = y + dy[k];
-        if (!m.inside(nx, ny)) {
+        const int ix = nx + m.x0, iy = ny + m.y0;  // image coordinates of the neighbour
+        if (ix < 0 || iy < 0 || ix >= m.image_width || iy >= m.image_height) {
           if (touches_border) *touches_border = true;
           continue;
         }
         if (outside[static_cast<size_t>(ny - y1 + 1) * w + (nx - x1 + 1)])
-          pts.emplace_back(x + 0.5 * dx[k], y + 0.5 * dy[k]);
+          pts.emplace_back(m.x0 + x + 0.5 * dx[k], m.y0 + y + 0.5 * dy[k]);
       }
     }
   }
