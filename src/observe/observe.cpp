@@ -6,15 +6,14 @@
 
 namespace ellreloc {
 
-std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, const BinaryMask& mask, MaskFitMethod method,
-                                      const RegularVerdict* verdict) {
+std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, MaskFitMethod method, const RegularVerdict* verdict) {
   switch (method) {
     case MaskFitMethod::Moments: {
       const auto m = rleMoments(rle);
       return m ? momentEllipse(*m) : std::nullopt;
     }
     case MaskFitMethod::Direct:
-      return fitEllipseDirect(maskOutline(mask));
+      return fitEllipseDirect(rleOutline(rle));
     case MaskFitMethod::Quadrilateral:
       if (!verdict || verdict->quad_vertices != 4) return std::nullopt;
       return projectivelyInscribedEllipse(verdict->corners);
@@ -64,13 +63,15 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
     r.observation = obs;
     return r;
   }
-  const auto mask = decodeMaskCrop(*d.mask);  // only the object's box: cost follows the object
-  if (!mask) {
+  // Everything below works on the runs: the cost follows the object's size, not the image's.
+  uint64_t ones = 0;
+  for (size_t i = 1; i < d.mask->counts.size(); i += 2) ones += d.mask->counts[i];
+  if (!d.mask->isConsistent() || ones == 0) {
     r.note = "empty or inconsistent mask: box-inscribed ellipse";
     r.observation = obs;
     return r;
   }
-  const RegularVerdict verdict = testRegularMask(*mask, opt.regular);
+  const RegularVerdict verdict = testRegularMask(*d.mask, opt.regular);
   obs.regular = verdict.regular;
   obs.truncated = obs.truncated || verdict.touches_border;
   if (opt.policy == ObservationPolicy::Paper && !verdict.regular) {
@@ -78,9 +79,8 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
     return r;
   }
   const MaskFitMethod method = verdict.regular ? opt.regular_fit : opt.irregular_fit;
-  std::optional<Ellipse> fitted = fitMaskEllipse(*d.mask, *mask, method, &verdict);
-  if (!fitted && method != MaskFitMethod::Moments)
-    fitted = fitMaskEllipse(*d.mask, *mask, MaskFitMethod::Moments, &verdict);
+  std::optional<Ellipse> fitted = fitMaskEllipse(*d.mask, method, &verdict);
+  if (!fitted && method != MaskFitMethod::Moments) fitted = fitMaskEllipse(*d.mask, MaskFitMethod::Moments, &verdict);
   if (!fitted || !fitted->isValid()) {
     r.note = "ellipse fit failed: box-inscribed ellipse";
     r.observation = obs;

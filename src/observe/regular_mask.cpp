@@ -1,81 +1,260 @@
 #include "ellreloc/observe/regular_mask.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <opencv2/imgproc.hpp>
+#include <limits>
 
 namespace ellreloc {
 
 namespace {
 
-/// Area of a polygon of pixel-centre vertices, grown by half a pixel all round: masks count
-/// whole pixels, contours run through pixel centres.
-double pixelArea(const std::vector<cv::Point>& poly) {
-  return std::abs(cv::contourArea(poly)) + 0.5 * cv::arcLength(poly, true) + 1.0;
+using Point = Eigen::Vector2d;
+
+double cross(const Point& o, const Point& a, const Point& b) {
+  return (a(0) - o(0)) * (b(1) - o(1)) - (a(1) - o(1)) * (b(0) - o(0));
+}
+
+double polygonArea(const std::vector<Point>& p) {
+  double a = 0.0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Point& u = p[i];
+    const Point& v = p[(i + 1) % p.size()];
+    a += u(0) * v(1) - u(1) * v(0);
+  }
+  return 0.5 * std::abs(a);
+}
+
+/// Reduces a convex polygon to `target` vertices by repeatedly dropping the vertex whose
+/// removal loses the least area (Visvalingam-Whyatt): a good inscribed quadrilateral or
+/// triangle of the hull, whatever the object's thickness.
+std::vector<Point> reduceTo(std::vector<Point> p, size_t target) {
+  const auto loss = [&p](size_t i) {
+    const size_t n = p.size();
+    return std::abs(cross(p[(i + n - 1) % n], p[i], p[(i + 1) % n]));
+  };
+  std::vector<double> losses(p.size());
+  for (size_t i = 0; i < p.size(); ++i) losses[i] = loss(i);
+  while (p.size() > target) {
+    const size_t best = static_cast<size_t>(std::min_element(losses.begin(), losses.end()) - losses.begin());
+    p.erase(p.begin() + static_cast<std::ptrdiff_t>(best));
+    losses.erase(losses.begin() + static_cast<std::ptrdiff_t>(best));
+    // Only the two neighbours of the removed vertex change.
+    const size_t n = p.size();
+    losses[(best + n - 1) % n] = loss((best + n - 1) % n);
+    losses[best % n] = loss(best % n);
+  }
+  return p;
+}
+
+/// The convex quadrilateral q moved inward by d on every side (intersections of the offset
+/// sides); false when it vanishes.
+bool shrinkQuad(const std::vector<Point>& q, double d, std::vector<Point>* out) {
+  // Orientation: positive area means counter-clockwise in a y-up frame.
+  double signed_area = 0.0;
+  for (int i = 0; i < 4; ++i) signed_area += q[i](0) * q[(i + 1) % 4](1) - q[i](1) * q[(i + 1) % 4](0);
+  const double side = signed_area > 0 ? 1.0 : -1.0;
+  Point n[4], p[4];
+  for (int i = 0; i < 4; ++i) {
+    const Point e = (q[(i + 1) % 4] - q[i]).normalized();
+    n[i] = side * Point(-e(1), e(0));  // inward normal
+    p[i] = q[i] + d * n[i];
+  }
+  out->resize(4);
+  for (int i = 0; i < 4; ++i) {
+    // Intersect offset side i-1 (through p[i-1], direction q[i]-q[i-1]) with side i.
+    const int j = (i + 3) % 4;
+    const Point d1 = q[i] - q[j], d2 = q[(i + 1) % 4] - q[i];
+    const double den = d1(0) * d2(1) - d1(1) * d2(0);
+    if (std::abs(den) < 1e-12) return false;
+    const Point w = p[i] - p[j];
+    const double t = (w(0) * d2(1) - w(1) * d2(0)) / den;
+    (*out)[i] = p[j] + t * d1;
+  }
+  // It vanished if the orientation flipped.
+  double a = 0.0;
+  for (int i = 0; i < 4; ++i) a += (*out)[i](0) * (*out)[(i + 1) % 4](1) - (*out)[i](1) * (*out)[(i + 1) % 4](0);
+  return a * signed_area > 0 && std::abs(a) > 1.0;
+}
+
+/// Mask pixels whose centre lies inside the convex polygon q, counted from the runs.
+long pixelsInside(const RleMask& rle, const std::vector<Point>& q) {
+  const uint64_t h = static_cast<uint64_t>(rle.height);
+  long n = 0;
+  uint64_t pos = 0;
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    uint64_t start = pos, remaining = rle.counts[i];
+    pos += rle.counts[i];
+    if (i % 2 == 0) continue;
+    while (remaining > 0) {
+      const int x = static_cast<int>(start / h), y0 = static_cast<int>(start % h);
+      const int len = static_cast<int>(std::min<uint64_t>(remaining, h - static_cast<uint64_t>(y0)));
+      // The polygon's vertical extent at this column.
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (size_t k = 0; k < q.size(); ++k) {
+        const Point& a = q[k];
+        const Point& b = q[(k + 1) % q.size()];
+        if ((a(0) - x) * (b(0) - x) > 0 || a(0) == b(0)) continue;
+        const double y = a(1) + (x - a(0)) / (b(0) - a(0)) * (b(1) - a(1));
+        lo = std::min(lo, y), hi = std::max(hi, y);
+      }
+      if (lo <= hi) {
+        const double first = std::max<double>(y0, std::ceil(lo)), last = std::min<double>(y0 + len - 1, std::floor(hi));
+        if (last >= first) n += static_cast<long>(last - first + 1);
+      }
+      start += static_cast<uint64_t>(len);
+      remaining -= static_cast<uint64_t>(len);
+    }
+  }
+  return n;
 }
 
 }  // namespace
 
-RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions& options) {
-  RegularVerdict v;
-  if (mask.width <= 0 || mask.height <= 0 || mask.data.size() != static_cast<size_t>(mask.width) * mask.height)
-    return v;
-  // Work on the mask's bounding box (plus a one-pixel frame so contours close).
-  int x1 = mask.width, y1 = mask.height, x2 = -1, y2 = -1;
-  long area = 0;
-  for (int y = 0; y < mask.height; ++y)
-    for (int x = 0; x < mask.width; ++x)
-      if (mask.at(x, y)) x1 = std::min(x1, x), x2 = std::max(x2, x), y1 = std::min(y1, y), y2 = std::max(y2, y), ++area;
-  if (area < options.min_pixels) return v;
-  v.touches_border = x1 + mask.x0 == 0 || y1 + mask.y0 == 0 || x2 + mask.x0 == mask.image_width - 1 ||
-                     y2 + mask.y0 == mask.image_height - 1;
-  cv::Mat roi = cv::Mat::zeros(y2 - y1 + 3, x2 - x1 + 3, CV_8U);
-  for (int y = y1; y <= y2; ++y)
-    for (int x = x1; x <= x2; ++x) roi.at<uint8_t>(y - y1 + 1, x - x1 + 1) = mask.at(x, y) ? 255 : 0;
-  std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(roi, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-  if (contours.empty()) return v;
-  // All outer contours together: a mask split in pieces is judged by its overall hull.
-  std::vector<cv::Point> all;
-  for (const auto& c : contours) all.insert(all.end(), c.begin(), c.end());
-  std::vector<cv::Point> hull;
-  cv::convexHull(all, hull);
-  v.hull_vertices = static_cast<int>(hull.size());
-  v.solidity = static_cast<double>(area) / pixelArea(hull);
-  const double perimeter = cv::arcLength(hull, true);
-  std::vector<cv::Point> quad;
-  // Simplify with a growing tolerance until four corners remain (or the tolerance is used up).
-  for (double k = 0.005; k <= options.max_simplification + 1e-12; k *= 1.25) {
-    cv::approxPolyDP(hull, quad, k * perimeter, true);
-    if (quad.size() <= 4) break;
+std::vector<MaskColumn> rleColumns(const RleMask& rle) {
+  std::vector<MaskColumn> cols;
+  if (!rle.isConsistent()) return cols;
+  const uint64_t h = static_cast<uint64_t>(rle.height);
+  uint64_t pos = 0;
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    uint64_t start = pos, remaining = rle.counts[i];
+    pos += rle.counts[i];
+    if (i % 2 == 0) continue;
+    while (remaining > 0) {  // a run may continue into the next columns
+      const int x = static_cast<int>(start / h);
+      const int y0 = static_cast<int>(start % h);
+      const int len = static_cast<int>(std::min<uint64_t>(remaining, h - static_cast<uint64_t>(y0)));
+      if (cols.empty() || cols.back().x != x) cols.push_back({x, y0, y0 + len - 1, 0});
+      MaskColumn& c = cols.back();
+      c.ymin = std::min(c.ymin, y0);
+      c.ymax = std::max(c.ymax, y0 + len - 1);
+      c.count += len;
+      start += static_cast<uint64_t>(len);
+      remaining -= static_cast<uint64_t>(len);
+    }
   }
+  return cols;
+}
+
+RegularVerdict testRegularMask(const RleMask& rle, const RegularMaskOptions& options) {
+  RegularVerdict v;
+  const std::vector<MaskColumn> cols = rleColumns(rle);
+  long area = 0;
+  for (const MaskColumn& c : cols) area += c.count;
+  if (area < options.min_pixels) return v;
+  v.touches_border = cols.front().x == 0 || cols.back().x == rle.width - 1;
+  for (const MaskColumn& c : cols) v.touches_border = v.touches_border || c.ymin == 0 || c.ymax == rle.height - 1;
+
+  // Convex hull of the pixel squares (Andrew's monotone chain): only the extreme corners of
+  // each vertical grid line X = x - 1/2 matter, and they come sorted by X.
+  std::vector<Point> top, bottom;  // per grid line: the highest and lowest corner
+  for (size_t i = 0; i <= cols.size(); ++i) {
+    // Grid line left of column i (and right of column i-1 when adjacent).
+    const bool has_left = i > 0, has_right = i < cols.size();
+    if (has_left && (!has_right || cols[i].x != cols[i - 1].x + 1)) {
+      const MaskColumn& c = cols[i - 1];  // closing the previous column on its right side
+      top.emplace_back(c.x + 0.5, c.ymin - 0.5);
+      bottom.emplace_back(c.x + 0.5, c.ymax + 0.5);
+    }
+    if (has_right) {
+      const MaskColumn& c = cols[i];
+      double lo = c.ymin, hi = c.ymax;
+      if (has_left && cols[i - 1].x == c.x - 1)
+        lo = std::min<double>(lo, cols[i - 1].ymin), hi = std::max<double>(hi, cols[i - 1].ymax);
+      top.emplace_back(c.x - 0.5, lo - 0.5);
+      bottom.emplace_back(c.x - 0.5, hi + 0.5);
+    }
+  }
+  // Image y points down: the upper chain keeps right turns on the top points, the lower chain
+  // on the bottom points walked backwards; together a closed hull.
+  std::vector<Point> hull;
+  for (const Point& p : top) {
+    while (hull.size() >= 2 && cross(hull[hull.size() - 2], hull.back(), p) <= 0) hull.pop_back();
+    hull.push_back(p);
+  }
+  const size_t upper = hull.size() + 1;
+  for (auto it = bottom.rbegin(); it != bottom.rend(); ++it) {
+    while (hull.size() >= upper && cross(hull[hull.size() - 2], hull.back(), *it) <= 0) hull.pop_back();
+    hull.push_back(*it);
+  }
+  while (hull.size() > 1 && (hull.back() - hull.front()).norm() < 1e-12) hull.pop_back();
+  v.hull_vertices = static_cast<int>(hull.size());
+  if (hull.size() < 3) return v;
+  v.solidity = static_cast<double>(area) / polygonArea(hull);
+  const std::vector<Point> quad = reduceTo(hull, 4);
   v.quad_vertices = static_cast<int>(quad.size());
   if (quad.size() != 4) return v;
-  v.fill = static_cast<double>(area) / pixelArea(quad);
-  // A noisy triangle can reach four corners first (one cut off); it is a triangle when three
+  v.fill = static_cast<double>(area) / polygonArea(quad);
+  // A triangle's hull also reduces to four corners (one cut off); it is a triangle when three
   // corners already enclose the mask as tightly as the regular range of fills allows.
-  std::vector<cv::Point> tri = quad;
-  for (double k = 0.005; tri.size() > 3 && k < 0.5; k *= 1.25) cv::approxPolyDP(hull, tri, k * perimeter, true);
-  if (tri.size() == 3) v.triangle_fill = static_cast<double>(area) / pixelArea(tri);
+  const std::vector<Point> tri = reduceTo(quad, 3);
+  v.triangle_fill = static_cast<double>(area) / polygonArea(tri);
   v.min_corner_angle_deg = 180.0;
   for (int i = 0; i < 4; ++i) {
-    const cv::Point2d p(quad[(i + 3) % 4]), c(quad[i]), n(quad[(i + 1) % 4]);
-    const cv::Point2d a = p - c, b = n - c;
-    const double ang =
-        std::acos(std::clamp(a.dot(b) / (std::hypot(a.x, a.y) * std::hypot(b.x, b.y) + 1e-12), -1.0, 1.0));
-    v.max_corner_angle_deg = std::max(v.max_corner_angle_deg, ang * 180.0 / M_PI);
-    v.min_corner_angle_deg = std::min(v.min_corner_angle_deg, ang * 180.0 / M_PI);
-    // Contours run through pixel centres: move the corner out so that both sides move out by
-    // half a pixel, onto the mask's outer edge (distance 0.5 / sin(angle / 2) on the bisector).
-    const cv::Point2d bis = -(a / std::hypot(a.x, a.y) + b / std::hypot(b.x, b.y));
-    const double bn = std::hypot(bis.x, bis.y);
-    const cv::Point2d out = bn > 1e-9 ? bis * (0.5 / std::sin(0.5 * ang) / bn) : cv::Point2d(0, 0);
-    v.corners[i] = Eigen::Vector2d(c.x + out.x + x1 - 1 + mask.x0, c.y + out.y + y1 - 1 + mask.y0);
+    const Point a = quad[(i + 3) % 4] - quad[i], b = quad[(i + 1) % 4] - quad[i];
+    const double ang = std::acos(std::clamp(a.dot(b) / (a.norm() * b.norm() + 1e-12), -1.0, 1.0)) * 180.0 / M_PI;
+    v.max_corner_angle_deg = std::max(v.max_corner_angle_deg, ang);
+    v.min_corner_angle_deg = std::min(v.min_corner_angle_deg, ang);
+    v.corners[i] = quad[i];  // hull vertices are pixel corners: on the mask's outer edge
   }
+  // Core fill: the quadrilateral moved inward by the boundary noise band must be almost all
+  // mask. Noise only nibbles at the edges; an L-shape or a notch leaves a hole in the core.
+  std::vector<Point> core;
+  v.core_fill = shrinkQuad(quad, options.noise_band_px, &core)
+                    ? static_cast<double>(pixelsInside(rle, core)) / polygonArea(core)
+                    : 1.0;  // too thin to have a core: judged by `fill` alone
   const bool triangle = v.triangle_fill >= options.min_fill && v.triangle_fill <= options.max_fill;
-  v.regular = !triangle && v.solidity >= options.min_solidity && v.fill >= options.min_fill &&
-              v.fill <= options.max_fill && v.max_corner_angle_deg <= options.max_corner_angle_deg &&
+  v.regular = !triangle && v.core_fill >= options.min_core_fill && v.solidity >= options.min_solidity &&
+              v.fill >= options.min_fill && v.fill <= options.max_fill &&
+              v.max_corner_angle_deg <= options.max_corner_angle_deg &&
               v.min_corner_angle_deg >= options.min_corner_angle_deg;
   return v;
+}
+
+RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions& options) {
+  return testRegularMask(encodeMask(mask), options);
+}
+
+std::vector<Eigen::Vector2d> rleOutline(const RleMask& rle, bool* touches_border) {
+  std::vector<Eigen::Vector2d> pts;
+  const std::vector<MaskColumn> cols = rleColumns(rle);
+  bool border = false;
+  const int W = rle.width, H = rle.height;
+  for (size_t i = 0; i < cols.size(); ++i) {
+    const MaskColumn& c = cols[i];
+    // Top and bottom edges of the column, unless on the image border.
+    if (c.ymin > 0)
+      pts.emplace_back(c.x, c.ymin - 0.5);
+    else
+      border = true;
+    if (c.ymax < H - 1)
+      pts.emplace_back(c.x, c.ymax + 0.5);
+    else
+      border = true;
+    // Vertical edges towards the left neighbour column (or empty space).
+    const bool adjacent = i > 0 && cols[i - 1].x == c.x - 1;
+    const double X = c.x - 0.5;
+    if (c.x == 0) {
+      border = true;
+    } else if (!adjacent) {
+      for (int y = c.ymin; y <= c.ymax; ++y) pts.emplace_back(X, y);
+    } else {
+      const MaskColumn& p = cols[i - 1];
+      for (int y = c.ymin; y < p.ymin && y <= c.ymax; ++y) pts.emplace_back(X, y);          // c sticks out above p
+      for (int y = std::max(c.ymin, p.ymax + 1); y <= c.ymax; ++y) pts.emplace_back(X, y);  // c sticks out below p
+      for (int y = p.ymin; y < c.ymin && y <= p.ymax; ++y) pts.emplace_back(X, y);          // p sticks out above c
+      for (int y = std::max(p.ymin, c.ymax + 1); y <= p.ymax; ++y) pts.emplace_back(X, y);  // p sticks out below c
+    }
+    // Right side of the last column of a group.
+    const bool next_adjacent = i + 1 < cols.size() && cols[i + 1].x == c.x + 1;
+    if (!next_adjacent) {
+      if (c.x == W - 1)
+        border = true;
+      else
+        for (int y = c.ymin; y <= c.ymax; ++y) pts.emplace_back(c.x + 0.5, y);
+    }
+  }
+  if (touches_border) *touches_border = border;
+  return pts;
 }
 
 }  // namespace ellreloc

@@ -31,19 +31,26 @@ inline std::optional<Ellipse> fitEllipseDirect(const std::vector<Eigen::Vector2d
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (const auto& p : points) mean += p;
   mean /= static_cast<double>(n);
-  double scale = 0.0;
-  for (const auto& p : points) scale += (p - mean).norm();
-  scale /= static_cast<double>(n);
+  double spread = 0.0;
+  for (const auto& p : points) spread += (p - mean).squaredNorm();
+  const double scale = std::sqrt(spread / static_cast<double>(n));  // RMS distance to the mean
   if (!(scale > 0.0) || !std::isfinite(scale)) return std::nullopt;
-  // Scatter matrices of D1 = [x^2, xy, y^2] and D2 = [x, y, 1].
-  Eigen::Matrix3d S1 = Eigen::Matrix3d::Zero(), S2 = Eigen::Matrix3d::Zero(), S3 = Eigen::Matrix3d::Zero();
+  // The scatter matrices of D1 = [x^2, xy, y^2] and D2 = [x, y, 1] only need the 15 monomial
+  // sums x^i y^j, i + j <= 4.
+  double s40 = 0, s31 = 0, s22 = 0, s13 = 0, s04 = 0, s30 = 0, s21 = 0, s12 = 0, s03 = 0, s20 = 0, s11 = 0, s02 = 0,
+         s10 = 0, s01 = 0;
+  const double inv = 1.0 / scale;
   for (const auto& p : points) {
-    const Eigen::Vector2d q = (p - mean) / scale;
-    const Eigen::Vector3d d1(q(0) * q(0), q(0) * q(1), q(1) * q(1)), d2(q(0), q(1), 1.0);
-    S1 += d1 * d1.transpose();
-    S2 += d1 * d2.transpose();
-    S3 += d2 * d2.transpose();
+    const double x = (p(0) - mean(0)) * inv, y = (p(1) - mean(1)) * inv;
+    const double xx = x * x, xy = x * y, yy = y * y;
+    s40 += xx * xx, s31 += xx * xy, s22 += xx * yy, s13 += xy * yy, s04 += yy * yy;
+    s30 += xx * x, s21 += xx * y, s12 += x * yy, s03 += yy * y;
+    s20 += xx, s11 += xy, s02 += yy, s10 += x, s01 += y;
   }
+  Eigen::Matrix3d S1, S2, S3;
+  S1 << s40, s31, s22, s31, s22, s13, s22, s13, s04;
+  S2 << s30, s21, s20, s21, s12, s11, s12, s03, s02;
+  S3 << s20, s11, s10, s11, s02, s01, s10, s01, static_cast<double>(n);
   const Eigen::FullPivLU<Eigen::Matrix3d> lu(S3);
   if (!lu.isInvertible()) return std::nullopt;
   const Eigen::Matrix3d T = -lu.solve(S2.transpose());  // a2 = T a1

@@ -52,8 +52,8 @@ struct ObserveResult {
 /// Observes one detection of an image of width x height pixels.
 ObserveResult observeDetection(const Detection& detection, int width, int height, const ObserveOptions& options = {});
 
-/// Fits an ellipse to a mask with the given method; `verdict` is needed by Quadrilateral.
-std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, const BinaryMask& mask, MaskFitMethod method,
-                                      const RegularVerdict* verdict);
+/// Fits an ellipse to a run-length mask with the given method (no decoding); `verdict` is
+/// needed by Quadrilateral.
+std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, MaskFitMethod method, const RegularVerdict* verdict);
 
 }  // namespace ellreloc

@@ -1,12 +1,14 @@
 #pragma once
 /// \file regular_mask.hpp
 /// Is a mask's outline roughly a convex quadrilateral (a "regular" object in the paper: a
-/// monitor, a book, a keyboard seen as one face)? Contour -> convex hull -> simplification to
-/// four corners; then checks of how well the mask fills its hull and the quadrilateral, and of
-/// the corners' angles.
+/// monitor, a book, a keyboard seen as one face)? Convex hull of the pixels -> reduction to the
+/// four corners that keep the most area; then checks that the mask fills that quadrilateral
+/// (overall, and in its core away from the noisy boundary), that three corners do not do as
+/// well (a triangle), and that the corners are real corners.
 
 #include <Eigen/Core>
 #include <array>
+#include <vector>
 
 #include "ellreloc/observe/mask.hpp"
 
@@ -16,32 +18,49 @@ namespace ellreloc {
 /// perspective quadrilaterals and thin face-on boxes are regular; ellipses, triangles,
 /// L-shapes, 2-3-face box silhouettes and blobs are not), with boundary noise.
 struct RegularMaskOptions {
-  /// Largest simplification tolerance, as a share of the hull's perimeter, at which the hull
-  /// must reduce to four corners.
-  double max_simplification = 0.04;
-  double min_solidity = 0.80;  ///< mask area / hull area (noisy thin boxes reach 0.82)
-  double min_fill = 0.88;      ///< mask area / quadrilateral area
-  double max_fill = 1.12;
-  double max_corner_angle_deg = 160.0;  ///< a corner flatter than this is no corner (triangles)
+  double min_solidity = 0.75;  ///< mask area / hull area (noisy thin boxes reach 0.80)
+  double min_fill = 0.85;      ///< mask area / quadrilateral area
+  double max_fill = 1.15;
+  double noise_band_px = 2.5;           ///< boundary noise expected on each side of the mask
+  double min_core_fill = 0.95;          ///< share of the quadrilateral shrunk by noise_band_px covered by the mask
+  double max_corner_angle_deg = 160.0;  ///< a corner flatter than this is no corner
   double min_corner_angle_deg = 20.0;
   int min_pixels = 30;  ///< smaller masks are never regular: too few pixels to tell
 };
 
 struct RegularVerdict {
   bool regular = false;
-  int hull_vertices = 0;  ///< vertices of the convex hull of the outer contour
-  int quad_vertices = 0;  ///< vertices after simplification at max_simplification
-  double solidity = 0.0;  ///< mask area / hull area
-  double fill = 0.0;      ///< mask area / quadrilateral area (0 when there is no quadrilateral)
-  double triangle_fill =
-      0.0;  ///< mask area / area of the best 3-corner simplification (a triangle if in the fill range)
+  int hull_vertices = 0;       ///< vertices of the convex hull of the mask's pixel squares
+  int quad_vertices = 0;       ///< vertices of the reduced hull: 4, or fewer for a tiny hull
+  double solidity = 0.0;       ///< mask area / hull area
+  double fill = 0.0;           ///< mask area / quadrilateral area (0 when there is no quadrilateral)
+  double core_fill = 0.0;      ///< mask share of the quadrilateral shrunk by the noise band
+  double triangle_fill = 0.0;  ///< mask area / area of the best 3-corner reduction (a triangle if in the fill range)
   double max_corner_angle_deg = 0.0;
   double min_corner_angle_deg = 0.0;
-  std::array<Eigen::Vector2d, 4> corners{};  ///< in order around the quadrilateral, when quad_vertices == 4
+  std::array<Eigen::Vector2d, 4> corners{};  ///< around the quadrilateral, on the mask's outer pixel edges
   bool touches_border = false;               ///< the mask reaches the image border
 };
 
-/// Tests a mask. An empty mask is not regular (all diagnostics 0).
+/// Tests a run-length mask without decoding it: the convex hull of the pixel squares comes from
+/// each column's extreme rows, O(runs + columns). An empty or inconsistent mask is not
+/// regular (all diagnostics 0).
+RegularVerdict testRegularMask(const RleMask& mask, const RegularMaskOptions& options = {});
 RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions& options = {});
+
+/// The rows a mask covers in one image column.
+struct MaskColumn {
+  int x = 0;
+  int ymin = 0, ymax = 0;  ///< first and last row with a mask pixel
+  int count = 0;           ///< mask pixels in the column
+};
+
+/// The non-empty columns of a run-length mask, in increasing x. Empty if inconsistent.
+std::vector<MaskColumn> rleColumns(const RleMask& rle);
+
+/// Outline points of the mask with every column filled between its extreme rows (holes and
+/// vertical notches closed): midpoints of the pixel edges on its boundary, image-border edges
+/// dropped (`touches_border` says whether there were any). From the runs, no decoding.
+std::vector<Eigen::Vector2d> rleOutline(const RleMask& rle, bool* touches_border = nullptr);
 
 }  // namespace ellreloc
