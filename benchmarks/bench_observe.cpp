@@ -41,10 +41,16 @@ void BM_ObserveOurs(benchmark::State& state) {
   d.mask = encodeMask(m);
   d.bbox = rleMoments(*d.mask)->bounds;
   ObserveOptions opt;
-  opt.policy = ObservationPolicy::Mask;
+  opt.policy = state.range(1) ? ObservationPolicy::Paper : ObservationPolicy::Mask;
   for (auto _ : state) benchmark::DoNotOptimize(observeDetection(d, 640, 480, opt));
 }
-BENCHMARK(BM_ObserveOurs)->ArgName("regular")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
+// policy 0: `mask` (always fit the mask); 1: `paper` (the default: irregular masks keep the box)
+BENCHMARK(BM_ObserveOurs)
+    ->ArgNames({"regular", "paper"})
+    ->Args({1, 0})
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_ObserveOpenCv(benchmark::State& state) {
   const BinaryMask m = makeMask(state.range(0));

@@ -4,16 +4,16 @@
 // the ellipsoid inscribed in the object's oriented bounding cuboid. Medians, split by the
 // regular verdict and by truncation.
 // Run: ./build/benchmarks/observe_accuracy
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <random>
+
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "observe/mask_shapes.hpp"
-
-#include <algorithm>
-#include <cstdio>
-#include <map>
-#include <random>
 
 using namespace ellreloc;
 
@@ -28,7 +28,8 @@ struct Part {  // a convex part: its surface points
 std::vector<Eigen::Vector3d> cuboid(const Eigen::Vector3d& c, const Eigen::Vector3d& half, const Eigen::Matrix3d& R) {
   std::vector<Eigen::Vector3d> p;
   for (int k = 0; k < 8; ++k)
-    p.push_back(c + R * Eigen::Vector3d((k & 1 ? 1 : -1) * half(0), (k & 2 ? 1 : -1) * half(1), (k & 4 ? 1 : -1) * half(2)));
+    p.push_back(
+        c + R * Eigen::Vector3d((k & 1 ? 1 : -1) * half(0), (k & 2 ? 1 : -1) * half(1), (k & 4 ? 1 : -1) * half(2)));
   return p;
 }
 
@@ -52,7 +53,8 @@ bool render(const std::vector<Part>& parts, const Pose& pose, BinaryMask* mask) 
       img.push_back(kK.project(xc));
     }
     // Convex hull (monotone chain) of the projected points.
-    std::sort(img.begin(), img.end(), [](const auto& a, const auto& b) { return a(0) < b(0) || (a(0) == b(0) && a(1) < b(1)); });
+    std::sort(img.begin(), img.end(),
+              [](const auto& a, const auto& b) { return a(0) < b(0) || (a(0) == b(0) && a(1) < b(1)); });
     std::vector<Eigen::Vector2d> hull;
     auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
       return (a(0) - o(0)) * (b(1) - o(1)) - (a(1) - o(1)) * (b(0) - o(0));
@@ -109,16 +111,19 @@ int main() {
       parts.push_back({cuboid(R * Eigen::Vector3d(0, 0, z0 + hs), {w, d, 0.02}, R)});
       parts.push_back({cuboid(R * Eigen::Vector3d(0, d - 0.02, z0 + hs + hb / 2), {w, 0.02, hb / 2}, R)});
       for (int k = 0; k < 4; ++k)
-        parts.push_back({cuboid(R * Eigen::Vector3d((k & 1 ? 1 : -1) * (w - 0.02), (k & 2 ? 1 : -1) * (d - 0.02), z0 + hs / 2),
-                                {0.02, 0.02, hs / 2}, R)});
+        parts.push_back(
+            {cuboid(R * Eigen::Vector3d((k & 1 ? 1 : -1) * (w - 0.02), (k & 2 ? 1 : -1) * (d - 0.02), z0 + hs / 2),
+                    {0.02, 0.02, hs / 2}, R)});
     }
     // Camera: 0.8-3 m away; thin boxes are seen within 35 degrees of their face normal.
     const double dist = 0.8 + 2.2 * u(rng);
     const double az = kind == 0 ? yaw + M_PI / 2 + (u(rng) - 0.5) * 1.2 : 2 * M_PI * u(rng);
     const double el = (u(rng) - 0.3) * 0.8;
-    const Eigen::Vector3d centre = dist * Eigen::Vector3d(std::cos(az) * std::cos(el), std::sin(az) * std::cos(el), std::sin(el));
+    const Eigen::Vector3d centre =
+        dist * Eigen::Vector3d(std::cos(az) * std::cos(el), std::sin(az) * std::cos(el), std::sin(el));
     // Look near the object, sometimes far enough off to cut it at the image border.
-    const Eigen::Vector3d target = Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) * (u(rng) < 0.2 ? 0.9 : 0.2) * dist;
+    const Eigen::Vector3d target =
+        Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) * (u(rng) < 0.2 ? 0.9 : 0.2) * dist;
     Eigen::Matrix3d R_wc;
     R_wc.col(2) = (target - centre).normalized();
     R_wc.col(0) = R_wc.col(2).cross(Eigen::Vector3d::UnitZ()).normalized();
@@ -135,27 +140,33 @@ int main() {
     if (!moments) continue;
     const RegularVerdict verdict = testRegularMask(rle);
     const double scale = std::sqrt(truth.ellipse.axes().prod());
-    const std::string group = std::string(verdict.regular ? "regular" : "irregular") + (verdict.touches_border ? ", truncated" : "");
+    const std::string group =
+        std::string(verdict.regular ? "regular" : "irregular") + (verdict.touches_border ? ", truncated" : "");
     auto record = [&](const std::string& method, const std::optional<Ellipse>& e) {
       if (e && e->isValid()) errors[group][method].push_back(wasserstein2(*e, truth.ellipse) / scale);
     };
     record("box-inscribed", Ellipse::inscribedInBox(moments->bounds));
     record("moments", fitMaskEllipse(rle, MaskFitMethod::Moments, &verdict));
     record("direct (outline)", fitMaskEllipse(rle, MaskFitMethod::Direct, &verdict));
-    if (verdict.quad_vertices == 4) record("quadrilateral", fitMaskEllipse(rle, MaskFitMethod::Quadrilateral, &verdict));
+    if (verdict.quad_vertices == 4)
+      record("quadrilateral", fitMaskEllipse(rle, MaskFitMethod::Quadrilateral, &verdict));
     Detection det;
     det.bbox = moments->bounds;
     det.mask = rle;
     const ObserveResult paper = observeDetection(det, kK.width, kK.height);
     if (paper.observation) record("default (paper policy)", paper.observation->ellipse);
   }
-  std::printf("| masks | n | box-inscribed | moments | direct (outline) | quadrilateral | default (paper policy) |\n|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| masks | n | box-inscribed | moments | direct (outline) | quadrilateral | default (paper policy) "
+      "|\n|---|---|---|---|---|---|---|\n");
   for (const auto& [group, methods] : errors) {
     std::printf("| %s | %zu |", group.c_str(), methods.at("box-inscribed").size());
     for (const char* m : {"box-inscribed", "moments", "direct (outline)", "quadrilateral", "default (paper policy)"}) {
       const auto it = methods.find(m);
-      if (it == methods.end()) std::printf(" - |");
-      else std::printf(" %.3f |", median(it->second));
+      if (it == methods.end())
+        std::printf(" - |");
+      else
+        std::printf(" %.3f |", median(it->second));
     }
     std::printf("\n");
   }

@@ -10,6 +10,30 @@ namespace {
 
 using Point = Eigen::Vector2d;
 
+/// Calls f(x, y0, length) for every vertical segment of ones (runs split at column ends),
+/// walking the runs with counters instead of 64-bit divisions.
+template <typename F>
+void forEachRunSegment(const RleMask& rle, F f) {
+  int x = 0, y = 0;
+  const int h = rle.height;
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    uint64_t remaining = rle.counts[i];
+    if (i % 2 == 0) {  // zeros: just advance
+      x += static_cast<int>(remaining / static_cast<uint64_t>(h));
+      y += static_cast<int>(remaining % static_cast<uint64_t>(h));
+      if (y >= h) y -= h, ++x;
+      continue;
+    }
+    while (remaining > 0) {
+      const int len = static_cast<int>(std::min<uint64_t>(remaining, static_cast<uint64_t>(h - y)));
+      f(x, y, len);
+      y += len;
+      remaining -= static_cast<uint64_t>(len);
+      if (y == h) y = 0, ++x;
+    }
+  }
+}
+
 double cross(const Point& o, const Point& a, const Point& b) {
   return (a(0) - o(0)) * (b(1) - o(1)) - (a(1) - o(1)) * (b(0) - o(0));
 }
@@ -78,33 +102,22 @@ bool shrinkQuad(const std::vector<Point>& q, double d, std::vector<Point>* out) 
 
 /// Mask pixels whose centre lies inside the convex polygon q, counted from the runs.
 long pixelsInside(const RleMask& rle, const std::vector<Point>& q) {
-  const uint64_t h = static_cast<uint64_t>(rle.height);
   long n = 0;
-  uint64_t pos = 0;
-  for (size_t i = 0; i < rle.counts.size(); ++i) {
-    uint64_t start = pos, remaining = rle.counts[i];
-    pos += rle.counts[i];
-    if (i % 2 == 0) continue;
-    while (remaining > 0) {
-      const int x = static_cast<int>(start / h), y0 = static_cast<int>(start % h);
-      const int len = static_cast<int>(std::min<uint64_t>(remaining, h - static_cast<uint64_t>(y0)));
-      // The polygon's vertical extent at this column.
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (size_t k = 0; k < q.size(); ++k) {
-        const Point& a = q[k];
-        const Point& b = q[(k + 1) % q.size()];
-        if ((a(0) - x) * (b(0) - x) > 0 || a(0) == b(0)) continue;
-        const double y = a(1) + (x - a(0)) / (b(0) - a(0)) * (b(1) - a(1));
-        lo = std::min(lo, y), hi = std::max(hi, y);
-      }
-      if (lo <= hi) {
-        const double first = std::max<double>(y0, std::ceil(lo)), last = std::min<double>(y0 + len - 1, std::floor(hi));
-        if (last >= first) n += static_cast<long>(last - first + 1);
-      }
-      start += static_cast<uint64_t>(len);
-      remaining -= static_cast<uint64_t>(len);
+  forEachRunSegment(rle, [&](int x, int y0, int len) {
+    // The polygon's vertical extent at this column.
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (size_t k = 0; k < q.size(); ++k) {
+      const Point& a = q[k];
+      const Point& b = q[(k + 1) % q.size()];
+      if ((a(0) - x) * (b(0) - x) > 0 || a(0) == b(0)) continue;
+      const double y = a(1) + (x - a(0)) / (b(0) - a(0)) * (b(1) - a(1));
+      lo = std::min(lo, y), hi = std::max(hi, y);
     }
-  }
+    if (lo <= hi) {
+      const double first = std::max<double>(y0, std::ceil(lo)), last = std::min<double>(y0 + len - 1, std::floor(hi));
+      if (last >= first) n += static_cast<long>(last - first + 1);
+    }
+  });
   return n;
 }
 
@@ -113,25 +126,14 @@ long pixelsInside(const RleMask& rle, const std::vector<Point>& q) {
 std::vector<MaskColumn> rleColumns(const RleMask& rle) {
   std::vector<MaskColumn> cols;
   if (!rle.isConsistent()) return cols;
-  const uint64_t h = static_cast<uint64_t>(rle.height);
-  uint64_t pos = 0;
-  for (size_t i = 0; i < rle.counts.size(); ++i) {
-    uint64_t start = pos, remaining = rle.counts[i];
-    pos += rle.counts[i];
-    if (i % 2 == 0) continue;
-    while (remaining > 0) {  // a run may continue into the next columns
-      const int x = static_cast<int>(start / h);
-      const int y0 = static_cast<int>(start % h);
-      const int len = static_cast<int>(std::min<uint64_t>(remaining, h - static_cast<uint64_t>(y0)));
-      if (cols.empty() || cols.back().x != x) cols.push_back({x, y0, y0 + len - 1, 0});
-      MaskColumn& c = cols.back();
-      c.ymin = std::min(c.ymin, y0);
-      c.ymax = std::max(c.ymax, y0 + len - 1);
-      c.count += len;
-      start += static_cast<uint64_t>(len);
-      remaining -= static_cast<uint64_t>(len);
-    }
-  }
+  cols.reserve(static_cast<size_t>(rle.width));
+  forEachRunSegment(rle, [&cols](int x, int y0, int len) {
+    if (cols.empty() || cols.back().x != x) cols.push_back({x, y0, y0 + len - 1, 0});
+    MaskColumn& c = cols.back();
+    c.ymin = std::min(c.ymin, y0);
+    c.ymax = std::max(c.ymax, y0 + len - 1);
+    c.count += len;
+  });
   return cols;
 }
 
@@ -217,6 +219,7 @@ RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions&
 std::vector<Eigen::Vector2d> rleOutline(const RleMask& rle, bool* touches_border) {
   std::vector<Eigen::Vector2d> pts;
   const std::vector<MaskColumn> cols = rleColumns(rle);
+  pts.reserve(4 * cols.size() + 64);
   bool border = false;
   const int W = rle.width, H = rle.height;
   for (size_t i = 0; i < cols.size(); ++i) {
