@@ -1,0 +1,40 @@
+#pragma once
+/// \file rgbd.hpp
+/// TUM RGB-D sequences: association files (`t_rgb rgb/X.png t_depth depth/Y.png`) and 16-bit
+/// depth PNGs with 5000 units per metre (0 = no reading).
+
+#include <string>
+#include <vector>
+
+namespace ellreloc::io {
+
+struct Association {
+  double rgb_time = 0.0;
+  std::string rgb_path;  ///< resolved against the association file's folder
+  double depth_time = 0.0;
+  std::string depth_path;  ///< resolved against the association file's folder
+};
+
+/// Reads an association file; relative paths are made relative to the file's own folder.
+/// `#` starts a comment. Throws ellreloc::Error naming the file and line on malformed input.
+std::vector<Association> readAssociations(const std::string& path);
+
+/// A depth image in metres, row-major; 0 where there is no reading.
+struct DepthImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> metres;
+  float at(int x, int y) const { return metres[static_cast<size_t>(y) * width + x]; }
+};
+
+/// TUM's scale: 5000 depth units per metre.
+constexpr double kTumDepthUnitsPerMetre = 5000.0;
+
+/// Reads a 16-bit single-channel depth PNG (units_per_metre units = 1 m). Throws
+/// ellreloc::Error when the file is missing, not a PNG, or not 16-bit single-channel.
+DepthImage readDepthPng(const std::string& path, double units_per_metre = kTumDepthUnitsPerMetre);
+
+/// Writes a 16-bit depth PNG (rounded; depths beyond 65535 units or invalid become 0), atomically.
+void writeDepthPng(const std::string& path, const DepthImage& depth, double units_per_metre = kTumDepthUnitsPerMetre);
+
+}  // namespace ellreloc::io

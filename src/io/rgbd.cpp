@@ -1,0 +1,85 @@
+#include "ellreloc/io/rgbd.hpp"
+
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/files.hpp"
+
+namespace ellreloc::io {
+
+namespace {
+
+std::string folderOf(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+std::string resolve(const std::string& folder, const std::string& p) {
+  return !p.empty() && p[0] == '/' ? p : folder + p;
+}
+
+}  // namespace
+
+std::vector<Association> readAssociations(const std::string& path) {
+  const std::string text = readTextFile(path);
+  const std::string folder = folderOf(path);
+  std::istringstream in(text);
+  std::string line;
+  std::vector<Association> out;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream fields(line);
+    Association a;
+    if (!(fields >> a.rgb_time >> a.rgb_path >> a.depth_time >> a.depth_path) || !std::isfinite(a.rgb_time) ||
+        !std::isfinite(a.depth_time))
+      throw Error(path + ": line " + std::to_string(line_no) + ": expected 't_rgb rgb/X.png t_depth depth/Y.png'");
+    a.rgb_path = resolve(folder, a.rgb_path);
+    a.depth_path = resolve(folder, a.depth_path);
+    out.push_back(std::move(a));
+  }
+  if (out.empty()) throw Error(path + ": no associations found (empty file)");
+  return out;
+}
+
+DepthImage readDepthPng(const std::string& path, double units_per_metre) {
+  readTextFile(path);  // names the file when it is missing or unreadable
+  cv::Mat img;
+  try {
+    img = cv::imread(path, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw Error(path + ": cannot decode image (" + e.msg + ")");
+  }
+  if (img.empty()) throw Error(path + ": not a readable image");
+  if (img.type() != CV_16UC1) throw Error(path + ": expected a 16-bit single-channel depth PNG");
+  DepthImage d;
+  d.width = img.cols;
+  d.height = img.rows;
+  d.metres.resize(static_cast<size_t>(img.rows) * img.cols);
+  const double scale = 1.0 / units_per_metre;
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x)
+      d.metres[static_cast<size_t>(y) * img.cols + x] = static_cast<float>(img.at<uint16_t>(y, x) * scale);
+  return d;
+}
+
+void writeDepthPng(const std::string& path, const DepthImage& depth, double units_per_metre) {
+  if (depth.width <= 0 || depth.height <= 0 || depth.metres.size() != static_cast<size_t>(depth.width) * depth.height)
+    throw Error(path + ": refusing to write a depth image whose size does not match its data");
+  cv::Mat img(depth.height, depth.width, CV_16UC1);
+  for (int y = 0; y < depth.height; ++y)
+    for (int x = 0; x < depth.width; ++x) {
+      const double units = std::round(depth.at(x, y) * units_per_metre);
+      img.at<uint16_t>(y, x) = std::isfinite(units) && units > 0 && units <= 65535 ? static_cast<uint16_t>(units) : 0;
+    }
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", img, png)) throw Error(path + ": PNG encoding failed");
+  writeFileAtomically(path, std::string(png.begin(), png.end()));
+}
+
+}  // namespace ellreloc::io
