@@ -98,8 +98,12 @@ RenderedFrame render(const Scene& scene, const Intrinsics& K, const Pose& pose) 
   f.width = K.width;
   f.height = K.height;
   const size_t n = static_cast<size_t>(K.width) * K.height;
-  std::vector<double> zbuf(n, kInf);
+  // The depth image doubles as the z-buffer (+inf = nothing yet; 0 at the end).
+  f.depth.assign(n, std::numeric_limits<float>::infinity());
+  std::vector<float>& zbuf = f.depth;
   f.instance.assign(n, kNoObject);
+  // A column-major copy for the run-length pass (RLE runs go down the columns).
+  std::vector<int16_t> instance_cm(n, kNoObject);
   const Eigen::Matrix3d R_wc = pose.rotation().transpose();
   const Eigen::Vector3d origin = pose.center();
   // World ray through pixel (x, y), scaled so its camera z is 1 (t = depth): linear in x, y.
@@ -111,7 +115,7 @@ RenderedFrame render(const Scene& scene, const Intrinsics& K, const Pose& pose) 
       const double dz = d0(2) + x * dx(2) + y * dy(2);
       if (dz < -1e-12) {
         const double t = -origin(2) / dz;
-        if (t > kNear) zbuf[static_cast<size_t>(y) * K.width + x] = t;
+        if (t > kNear) zbuf[static_cast<size_t>(y) * K.width + x] = static_cast<float>(t);
       }
     }
   auto draw = [&](const Primitive& p, int16_t id) {
@@ -124,15 +128,19 @@ RenderedFrame render(const Scene& scene, const Intrinsics& K, const Pose& pose) 
       for (int x = x0; x <= x1; ++x) {
         const double t = localRayDepth(p, o, row + x * lx);
         const size_t i = static_cast<size_t>(y) * K.width + x;
-        if (t < zbuf[i]) zbuf[i] = t, f.instance[i] = id;
+        if (t < zbuf[i]) {
+          zbuf[i] = static_cast<float>(t);
+          f.instance[i] = id;
+          instance_cm[static_cast<size_t>(x) * K.height + y] = id;
+        }
       }
     }
   };
   for (const Primitive& p : scene.furniture) draw(p, kNoObject);
   for (size_t j = 0; j < scene.objects.size(); ++j)
     for (const Primitive& p : scene.objects[j].parts) draw(p, static_cast<int16_t>(j));
-  f.depth.resize(n);
-  for (size_t i = 0; i < n; ++i) f.depth[i] = std::isfinite(zbuf[i]) ? static_cast<float>(zbuf[i]) : 0.0f;
+  for (float& z : f.depth)
+    if (!std::isfinite(z)) z = 0.0f;
 
   // All instance masks in one column-major pass: a run ends where the instance changes.
   const size_t m = scene.objects.size();
@@ -144,7 +152,7 @@ RenderedFrame render(const Scene& scene, const Intrinsics& K, const Pose& pose) 
   uint64_t k = 0;
   for (int x = 0; x < K.width; ++x)
     for (int y = 0; y < K.height; ++y, ++k) {
-      const int id = f.instance[static_cast<size_t>(y) * K.width + x];
+      const int id = instance_cm[k];
       if (id != prev) {
         if (prev != kNoObject) {  // prev's run of ones ends here
           f.masks[prev].counts.push_back(static_cast<uint32_t>(k - run_start[prev]));
