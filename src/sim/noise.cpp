@@ -1,0 +1,147 @@
+#include "ellreloc/sim/noise.hpp"
+
+#include "ellreloc/observe/mask.hpp"
+
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+
+namespace ellreloc::sim {
+
+NoiseModel NoiseModel::preset(NoiseLevel level) {
+  NoiseModel m;
+  if (level == NoiseLevel::Realistic) {
+    m.mask_boundary_px = 2;
+    m.box_jitter_px = 2.0;
+    m.miss_rate = 0.1;
+    m.false_positives = 0.3;
+    m.label_confusion = 0.03;
+    m.depth_sigma_at_2m = 0.01;
+    m.map_centre_sigma = 0.02;
+    m.map_axis_sigma = 0.08;
+    m.map_yaw_sigma_deg = 4.0;
+  } else if (level == NoiseLevel::Hard) {
+    m.mask_boundary_px = 3;
+    m.box_jitter_px = 5.0;
+    m.miss_rate = 0.25;
+    m.false_positives = 1.0;
+    m.label_confusion = 0.1;
+    m.depth_sigma_at_2m = 0.03;
+    m.map_centre_sigma = 0.05;
+    m.map_axis_sigma = 0.15;
+    m.map_yaw_sigma_deg = 10.0;
+  }
+  return m;
+}
+
+const char* toString(NoiseLevel level) {
+  switch (level) {
+    case NoiseLevel::None: return "none";
+    case NoiseLevel::Realistic: return "realistic";
+    case NoiseLevel::Hard: return "hard";
+  }
+  return "none";
+}
+
+bool parseNoiseLevel(const std::string& name, NoiseLevel* level) {
+  for (NoiseLevel l : {NoiseLevel::None, NoiseLevel::Realistic, NoiseLevel::Hard})
+    if (name == toString(l)) {
+      *level = l;
+      return true;
+    }
+  return false;
+}
+
+namespace {
+
+/// Erodes or dilates a mask by r pixels (a disc), r drawn in [1, max_px].
+RleMask morphNoise(const RleMask& rle, int max_px, std::mt19937_64& rng) {
+  const auto m = decodeMask(rle);
+  if (!m || max_px <= 0) return rle;
+  cv::Mat img(m->height, m->width, CV_8U, const_cast<uint8_t*>(m->data.data()));
+  const int r = std::uniform_int_distribution<int>(1, max_px)(rng);
+  const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+  cv::Mat out;
+  if (std::bernoulli_distribution(0.5)(rng)) cv::dilate(img, out, disc);
+  else cv::erode(img, out, disc);
+  BinaryMask noisy(m->height, m->width);
+  std::copy(out.data, out.data + noisy.data.size(), noisy.data.begin());
+  return encodeMask(noisy);
+}
+
+}  // namespace
+
+std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Detection> out;
+  const Box image(-0.5, -0.5, frame.width - 0.5, frame.height - 0.5);
+  for (size_t j = 0; j < scene.objects.size(); ++j) {
+    if (frame.visible_pixels[j] < noise.min_visible_pixels || u(rng) < noise.miss_rate) continue;
+    Detection d;
+    d.category_id = scene.objects[j].category;
+    if (u(rng) < noise.label_confusion) d.category_id = scene.objects[(j + 1 + static_cast<size_t>(u(rng) * 7)) % scene.objects.size()].category;
+    d.score = std::clamp(0.6 + 0.35 * u(rng), 0.0, 1.0);
+    d.mask = noise.mask_boundary_px > 0 ? morphNoise(frame.masks[j], noise.mask_boundary_px, rng) : frame.masks[j];
+    const auto moments = rleMoments(*d.mask);
+    if (!moments) continue;  // eroded away
+    const Box& b = moments->bounds;
+    d.bbox = Box(b.x1 + noise.box_jitter_px * g(rng), b.y1 + noise.box_jitter_px * g(rng), b.x2 + noise.box_jitter_px * g(rng),
+                 b.y2 + noise.box_jitter_px * g(rng))
+                 .intersection(image);
+    if (!(d.bbox.width() > 2) || !(d.bbox.height() > 2)) continue;
+    d.object_id = scene.objects[j].id;
+    out.push_back(std::move(d));
+  }
+  // False positives: random boxes with blob masks of a random category.
+  std::poisson_distribution<int> fp(noise.false_positives);
+  for (int k = noise.false_positives > 0 ? fp(rng) : 0; k > 0; --k) {
+    const double w = 20 + 100 * u(rng), h = 20 + 100 * u(rng);
+    const double x = (frame.width - w) * u(rng), y = (frame.height - h) * u(rng);
+    BinaryMask m(frame.height, frame.width);
+    const Ellipse e({x + w / 2, y + h / 2}, {w / 2, h / 2}, 0.0);
+    for (int yy = static_cast<int>(y); yy < static_cast<int>(y + h) && yy < frame.height; ++yy)
+      for (int xx = static_cast<int>(x); xx < static_cast<int>(x + w) && xx < frame.width; ++xx) m.at(xx, yy) = e.contains({double(xx), double(yy)});
+    Detection d;
+    d.category_id = scene.objects[static_cast<size_t>(u(rng) * scene.objects.size()) % scene.objects.size()].category;
+    d.score = 0.3 + 0.4 * u(rng);
+    d.mask = encodeMask(m);
+    const auto moments = rleMoments(*d.mask);
+    if (!moments) continue;
+    d.bbox = moments->bounds;
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+io::DepthImage noisyDepth(const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng) {
+  io::DepthImage d;
+  d.width = frame.width;
+  d.height = frame.height;
+  d.metres = frame.depth;
+  if (noise.depth_sigma_at_2m > 0) {
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (float& z : d.metres)
+      if (z > 0) z = std::max(0.0f, static_cast<float>(z + noise.depth_sigma_at_2m * (z / 2.0) * (z / 2.0) * g(rng)));
+  }
+  return d;
+}
+
+ObjectMap perturbMap(const ObjectMap& map, const NoiseModel& noise, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  ObjectMap out = map;
+  for (MapObject& o : out.objects) {
+    const Ellipsoid& e = o.ellipsoid;
+    const Eigen::Vector3d c = e.center() + noise.map_centre_sigma * Eigen::Vector3d(g(rng), g(rng), g(rng));
+    Eigen::Vector3d axes = e.axes();
+    for (int k = 0; k < 3; ++k) axes(k) *= std::max(0.3, 1.0 + noise.map_axis_sigma * g(rng));
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(noise.map_yaw_sigma_deg * M_PI / 180.0 * g(rng), Eigen::Vector3d::UnitZ()).toRotationMatrix() * e.rotation();
+    o.ellipsoid = Ellipsoid(c, axes, R);
+  }
+  return out;
+}
+
+}  // namespace ellreloc::sim
