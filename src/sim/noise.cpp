@@ -1,11 +1,10 @@
 #include "ellreloc/sim/noise.hpp"
 
-#include "ellreloc/observe/mask.hpp"
-
 #include <Eigen/Geometry>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include <cmath>
+#include "ellreloc/observe/mask.hpp"
 
 namespace ellreloc::sim {
 
@@ -18,6 +17,8 @@ NoiseModel NoiseModel::preset(NoiseLevel level) {
     m.false_positives = 0.3;
     m.label_confusion = 0.03;
     m.depth_sigma_at_2m = 0.01;
+    m.keypoint_sigma_px = 1.0;
+    m.keypoint_outliers = 0.2;
     m.map_centre_sigma = 0.02;
     m.map_axis_sigma = 0.08;
     m.map_yaw_sigma_deg = 4.0;
@@ -28,6 +29,8 @@ NoiseModel NoiseModel::preset(NoiseLevel level) {
     m.false_positives = 1.0;
     m.label_confusion = 0.1;
     m.depth_sigma_at_2m = 0.03;
+    m.keypoint_sigma_px = 2.0;
+    m.keypoint_outliers = 0.4;
     m.map_centre_sigma = 0.05;
     m.map_axis_sigma = 0.15;
     m.map_yaw_sigma_deg = 10.0;
@@ -37,9 +40,12 @@ NoiseModel NoiseModel::preset(NoiseLevel level) {
 
 const char* toString(NoiseLevel level) {
   switch (level) {
-    case NoiseLevel::None: return "none";
-    case NoiseLevel::Realistic: return "realistic";
-    case NoiseLevel::Hard: return "hard";
+    case NoiseLevel::None:
+      return "none";
+    case NoiseLevel::Realistic:
+      return "realistic";
+    case NoiseLevel::Hard:
+      return "hard";
   }
   return "none";
 }
@@ -63,8 +69,10 @@ RleMask morphNoise(const RleMask& rle, int max_px, std::mt19937_64& rng) {
   const int r = std::uniform_int_distribution<int>(1, max_px)(rng);
   const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
   cv::Mat out;
-  if (std::bernoulli_distribution(0.5)(rng)) cv::dilate(img, out, disc);
-  else cv::erode(img, out, disc);
+  if (std::bernoulli_distribution(0.5)(rng))
+    cv::dilate(img, out, disc);
+  else
+    cv::erode(img, out, disc);
   BinaryMask noisy(m->height, m->width);
   std::copy(out.data, out.data + noisy.data.size(), noisy.data.begin());
   return encodeMask(noisy);
@@ -72,7 +80,8 @@ RleMask morphNoise(const RleMask& rle, int max_px, std::mt19937_64& rng) {
 
 }  // namespace
 
-std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng) {
+std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, const NoiseModel& noise,
+                              std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<Detection> out;
@@ -81,14 +90,15 @@ std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, co
     if (frame.visible_pixels[j] < noise.min_visible_pixels || u(rng) < noise.miss_rate) continue;
     Detection d;
     d.category_id = scene.objects[j].category;
-    if (u(rng) < noise.label_confusion) d.category_id = scene.objects[(j + 1 + static_cast<size_t>(u(rng) * 7)) % scene.objects.size()].category;
+    if (u(rng) < noise.label_confusion)
+      d.category_id = scene.objects[(j + 1 + static_cast<size_t>(u(rng) * 7)) % scene.objects.size()].category;
     d.score = std::clamp(0.6 + 0.35 * u(rng), 0.0, 1.0);
     d.mask = noise.mask_boundary_px > 0 ? morphNoise(frame.masks[j], noise.mask_boundary_px, rng) : frame.masks[j];
     const auto moments = rleMoments(*d.mask);
     if (!moments) continue;  // eroded away
     const Box& b = moments->bounds;
-    d.bbox = Box(b.x1 + noise.box_jitter_px * g(rng), b.y1 + noise.box_jitter_px * g(rng), b.x2 + noise.box_jitter_px * g(rng),
-                 b.y2 + noise.box_jitter_px * g(rng))
+    d.bbox = Box(b.x1 + noise.box_jitter_px * g(rng), b.y1 + noise.box_jitter_px * g(rng),
+                 b.x2 + noise.box_jitter_px * g(rng), b.y2 + noise.box_jitter_px * g(rng))
                  .intersection(image);
     if (!(d.bbox.width() > 2) || !(d.bbox.height() > 2)) continue;
     d.object_id = scene.objects[j].id;
@@ -102,7 +112,8 @@ std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, co
     BinaryMask m(frame.height, frame.width);
     const Ellipse e({x + w / 2, y + h / 2}, {w / 2, h / 2}, 0.0);
     for (int yy = static_cast<int>(y); yy < static_cast<int>(y + h) && yy < frame.height; ++yy)
-      for (int xx = static_cast<int>(x); xx < static_cast<int>(x + w) && xx < frame.width; ++xx) m.at(xx, yy) = e.contains({double(xx), double(yy)});
+      for (int xx = static_cast<int>(x); xx < static_cast<int>(x + w) && xx < frame.width; ++xx)
+        m.at(xx, yy) = e.contains({double(xx), double(yy)});
     Detection d;
     d.category_id = scene.objects[static_cast<size_t>(u(rng) * scene.objects.size()) % scene.objects.size()].category;
     d.score = 0.3 + 0.4 * u(rng);
@@ -111,6 +122,29 @@ std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, co
     if (!moments) continue;
     d.bbox = moments->bounds;
     out.push_back(std::move(d));
+  }
+  return out;
+}
+
+std::vector<Keypoint> keypoints(const Scene& scene, const RenderedFrame& frame, const Intrinsics& K, const Pose& pose,
+                                const NoiseModel& noise, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Keypoint> out;
+  const int n = static_cast<int>(scene.points.size());
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = pose.transform(scene.points[i]);
+    if (x(2) < 0.1) continue;
+    const Eigen::Vector2d uv = K.project(x);
+    const int px = static_cast<int>(std::lround(uv(0))), py = static_cast<int>(std::lround(uv(1)));
+    if (px < 0 || py < 0 || px >= frame.width || py >= frame.height) continue;
+    const float z = frame.depthAt(px, py);
+    if (z > 0 && x(2) > z + 0.03) continue;  // hidden behind another surface
+    Keypoint k;
+    k.point_index = i;
+    k.uv = uv + noise.keypoint_sigma_px * Eigen::Vector2d(g(rng), g(rng));
+    if (u(rng) < noise.keypoint_outliers) k.point_index = static_cast<int>(u(rng) * n) % n;  // a wrong match
+    out.push_back(k);
   }
   return out;
 }
@@ -138,7 +172,9 @@ ObjectMap perturbMap(const ObjectMap& map, const NoiseModel& noise, uint64_t see
     Eigen::Vector3d axes = e.axes();
     for (int k = 0; k < 3; ++k) axes(k) *= std::max(0.3, 1.0 + noise.map_axis_sigma * g(rng));
     const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(noise.map_yaw_sigma_deg * M_PI / 180.0 * g(rng), Eigen::Vector3d::UnitZ()).toRotationMatrix() * e.rotation();
+        Eigen::AngleAxisd(noise.map_yaw_sigma_deg * M_PI / 180.0 * g(rng), Eigen::Vector3d::UnitZ())
+            .toRotationMatrix() *
+        e.rotation();
     o.ellipsoid = Ellipsoid(c, axes, R);
   }
   return out;

@@ -1,5 +1,11 @@
 #include "ellreloc/sim/writer.hpp"
 
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
@@ -8,13 +14,6 @@
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
 #include "ellreloc/sim/render.hpp"
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-
-#include <cstdio>
-#include <filesystem>
-#include <sstream>
 
 namespace ellreloc::sim {
 
@@ -35,8 +34,9 @@ void writeRgb(const std::string& path, const RenderedFrame& f) {
       const float z = f.depthAt(x, y);
       const double shade = z > 0 ? std::clamp(1.2 - 0.15 * z, 0.3, 1.0) : 0.0;
       cv::Vec3b c(170, 170, 170);
-      if (id >= 0) c = cv::Vec3b(static_cast<uint8_t>(60 + (id * 97) % 196), static_cast<uint8_t>(60 + (id * 57) % 196),
-                                 static_cast<uint8_t>(60 + (id * 151) % 196));
+      if (id >= 0)
+        c = cv::Vec3b(static_cast<uint8_t>(60 + (id * 97) % 196), static_cast<uint8_t>(60 + (id * 57) % 196),
+                      static_cast<uint8_t>(60 + (id * 151) % 196));
       img.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uint8_t>(c[0] * shade), static_cast<uint8_t>(c[1] * shade),
                                           static_cast<uint8_t>(c[2] * shade));
     }
@@ -112,7 +112,8 @@ SimulationSummary writeSimulation(const std::string& dir, const SimulationOption
       wrote("query/rgb/" + name);
     }
     query_poses.push_back({t, query[i]});
-    query_dets.push_back({"rgb/" + name, detect(scene, f, noise, rng), {}});
+    query_dets.push_back(
+        {"rgb/" + name, detect(scene, f, noise, rng), keypoints(scene, f, opt.camera, query[i], noise, rng)});
     summary.query_detections += static_cast<int>(query_dets.back().detections.size());
   }
   io::writeDetections(dir + "/query/detections.json", query_dets);

@@ -1,3 +1,8 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "../io/temp_dir.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/files.hpp"
@@ -8,12 +13,6 @@
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/sim/noise.hpp"
 #include "ellreloc/sim/writer.hpp"
-
-#include "../io/temp_dir.hpp"
-
-#include <gtest/gtest.h>
-
-#include <filesystem>
 
 using namespace ellreloc;
 using namespace ellreloc::sim;
@@ -57,10 +56,10 @@ TEST(Noise, RealisticNoiseAndPerturbedMap) {
       EXPECT_TRUE(d.mask->isConsistent());
     }
   }
-  EXPECT_LT(detected, visible);             // some missed
-  EXPECT_GT(detected, 0.7 * visible);       // ~10% missed
+  EXPECT_LT(detected, visible);        // some missed
+  EXPECT_GT(detected, 0.7 * visible);  // ~10% missed
   EXPECT_GT(false_pos, 0);
-  EXPECT_GT(moved_masks, 0.9 * detected);   // boundaries eroded or dilated
+  EXPECT_GT(moved_masks, 0.9 * detected);  // boundaries eroded or dilated
   const ObjectMap truth = s.groundTruthMap();
   const ObjectMap noisy = perturbMap(truth, noise, 3);
   double centre_sq = 0.0;
@@ -131,4 +130,21 @@ TEST(Writer, SimulatedQueriesRelocalize) {
   }
   EXPECT_GE(tried, 5);
   EXPECT_GE(good, tried - 1);
+}
+
+TEST(Noise, KeypointsAreVisibleMapPointsWithOutliers) {
+  const Scene s = makeScene(ScenePreset::Office, 8);
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const Pose pose = queryTrajectory(s, 1, 4)[0];
+  const RenderedFrame f = render(s, K, pose);
+  std::mt19937_64 rng(5);
+  const auto clean = keypoints(s, f, K, pose, NoiseModel::preset(NoiseLevel::None), rng);
+  ASSERT_GT(clean.size(), 20u);
+  for (const Keypoint& k : clean) EXPECT_LT((K.project(pose.transform(s.points[k.point_index])) - k.uv).norm(), 1e-9);
+  NoiseModel noisy = NoiseModel::preset(NoiseLevel::Realistic);
+  const auto kps = keypoints(s, f, K, pose, noisy, rng);
+  int wrong = 0;
+  for (const Keypoint& k : kps) wrong += (K.project(pose.transform(s.points[k.point_index])) - k.uv).norm() > 10.0;
+  EXPECT_GT(wrong, 0);
+  EXPECT_LT(wrong, static_cast<int>(0.4 * kps.size()));
 }

@@ -5,15 +5,15 @@
 /// missed detections, false positives, label confusion, depth noise growing with distance, and
 /// a perturbed map (centre, axis and yaw errors).
 
+#include <random>
+#include <string>
+#include <vector>
+
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/sim/render.hpp"
 #include "ellreloc/sim/scene.hpp"
-
-#include <random>
-#include <string>
-#include <vector>
 
 namespace ellreloc::sim {
 
@@ -27,9 +27,11 @@ struct NoiseModel {
   double label_confusion = 0.0;     ///< share of detections given a wrong category
   double depth_sigma_at_2m = 0.0;   ///< depth noise (m) at 2 m, growing with the square of depth
   double min_visible_pixels = 150;  ///< smaller visible parts are not detected
+  double keypoint_sigma_px = 0.0;   ///< pixel noise of keypoints matched to map points
+  double keypoint_outliers = 0.0;   ///< share of keypoint matches that are wrong
   // A realistic mapper's errors, for the perturbed map:
-  double map_centre_sigma = 0.0;    ///< metres, per axis
-  double map_axis_sigma = 0.0;      ///< relative
+  double map_centre_sigma = 0.0;  ///< metres, per axis
+  double map_axis_sigma = 0.0;    ///< relative
   double map_yaw_sigma_deg = 0.0;
 
   static NoiseModel preset(NoiseLevel level);
@@ -40,7 +42,14 @@ bool parseNoiseLevel(const std::string& name, NoiseLevel* level);
 
 /// Detections of one rendered frame: a box and an instance mask per visible object, with noise.
 /// `object_id` carries the ground-truth object index (kept by the writer for evaluation).
-std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng);
+std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, const NoiseModel& noise,
+                              std::mt19937_64& rng);
+
+/// Keypoints of a frame: the map points visible from the pose (in front, inside the image, not
+/// hidden: within 3 cm of the rendered depth), with pixel noise, a share of them matched to a
+/// wrong map point (as a feature matcher's outliers).
+std::vector<Keypoint> keypoints(const Scene& scene, const RenderedFrame& frame, const Intrinsics& K, const Pose& pose,
+                                const NoiseModel& noise, std::mt19937_64& rng);
 
 /// The frame's depth in metres with noise (sigma growing with depth^2); 0 stays 0.
 io::DepthImage noisyDepth(const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng);

@@ -11,16 +11,16 @@
 ///     DIR/mapping/trajectory.txt      TUM, camera->world
 ///     DIR/mapping/detections.json     boxes + instance masks (COCO RLE), with object_id
 ///     DIR/query/rgb/                  colour-coded renderings of the query frames
-///     DIR/query/detections.json       boxes + masks of the query frames
+///     DIR/query/detections.json       boxes + masks of the query frames, keypoints matched to the map points
 ///     DIR/query/groundtruth.txt       TUM, camera->world
-
-#include "ellreloc/core/camera.hpp"
-#include "ellreloc/sim/noise.hpp"
-#include "ellreloc/sim/scene.hpp"
 
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "ellreloc/core/camera.hpp"
+#include "ellreloc/sim/noise.hpp"
+#include "ellreloc/sim/scene.hpp"
 
 namespace ellreloc::sim {
 
