@@ -40,7 +40,11 @@ struct RelocalizerOptions {
   HypothesisSampler sampler = HypothesisSampler::Auto;
   long max_exhaustive_triplets = 1000;
   OverlapMeasure overlap = OverlapMeasure::EllipseIoU;
-  double min_overlap = 0.25;  ///< a match below this overlap is no match (the cost's truncation)
+  /// A match below this overlap is no match (the cost's truncation). Low, because a true match
+  /// of an inexact map and a box-inscribed ellipse often overlaps little: 0.15 did better than
+  /// 0.25 both on the real fr2_desk map (64.1% valid against 61.1%) and on the simulated
+  /// office with a perturbed map (97.0% against 93.0%).
+  double min_overlap = 0.15;
   /// An object is a candidate for an observation of category c when at least this share of
   /// its mapped detections carried c (MapObject::categoryShare): detectors confuse cups with
   /// mice and books with plants, and maps that keep a label histogram know it. With no
@@ -76,6 +80,7 @@ struct RelocalizerOptions {
     o.correct_centres = false;
     o.check_sample_overlap = false;
     o.min_category_share = 1.0;  // equal (majority) categories only
+    o.min_overlap = 0.25;
     o.refine = false;
     o.refine_top_k = 1;
     o.ransac.min_iterations = 1 << 30;  // enumerate everything, no adaptive stop
