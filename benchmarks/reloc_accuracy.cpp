@@ -1,6 +1,6 @@
 // Relocalization accuracy and time per query on real and synthetic data, ours against the
 // OA-SLAM preset, in one run. Prints the rows of docs/benchmarks.md.
-// Run: ./build/benchmarks/reloc_accuracy [data_dir]
+// Run: ./build/benchmarks/reloc_accuracy [data_dir] [--ours-only]
 #include <algorithm>
 #include <cstdio>
 
@@ -109,7 +109,12 @@ bench::RelocalizationDataset simulated(sim::ScenePreset preset, int frames, uint
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
-  const std::string data = argc > 1 ? argv[1] : ELLRELOC_BENCH_DATA_DIR;
+  std::string data = ELLRELOC_BENCH_DATA_DIR;
+  bool ours_only = false;  // skip the slow exhaustive preset (for timing runs of ours)
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--ours-only") ours_only = true;
+    else data = argv[i];
+  }
   const auto fr2 = bench::loadFr2Desk(data);
   std::printf(
       "| data             | method                 | valid  | median pos | median rot | median time | max time | "
@@ -122,6 +127,7 @@ int main(int argc, char** argv) {
         simulated(sim::ScenePreset::Cluttered, 200, 32)}) {
     evaluate("ours", d, RelocalizerOptions());
     evaluate("ours, no refinement", d, unrefined);
+    if (ours_only) continue;
     // The exhaustive preset takes seconds per frame on the cluttered scene (40 objects, many
     // of one category): measured on 20 of its frames only.
     if (d.name == "sim cluttered") {
