@@ -26,8 +26,8 @@ const char* toString(RelocalizationStatus s) {
 namespace {
 
 /// Vertices of the polygon used by ellipseIoU while scoring hypotheses: IoU error ~1e-2,
-/// ample to rank poses, and twice as fast as the default 128.
-constexpr int kScoringIoUVertices = 48;
+/// ample to rank poses (fr2_desk and simulated results identical to 48), 3x faster than 128.
+constexpr int kScoringIoUVertices = 32;
 
 struct CandidatePair {
   int obs;
