@@ -185,3 +185,39 @@ TEST(ObjectRelocalizer, OaSlamPresetAlsoWorksOnBoxes) {
   EXPECT_FALSE(r.refined);
   EXPECT_LT(positionError(r.pose, s.truth), 0.3);
 }
+
+TEST(ObjectRelocalizer, SymmetricLayoutsAreExplainedAndBrokenByOneDistinctObject) {
+  const Intrinsics K = test::testIntrinsics();
+  // Four identical cups on the corners of a square: a quarter turn of the camera about the
+  // square's axis explains the image equally well.
+  ObjectMap map;
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  for (int k = 0; k < 4; ++k)
+    map.objects.push_back(
+        {k, 41, "cup", Ellipsoid({0.5 * (k & 1 ? 1 : -1), 0.5 * (k & 2 ? 1 : -1), 0.0}, {0.06, 0.06, 0.09}, I)});
+  const Pose truth = Pose::fromCameraToWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+                                             Eigen::Vector3d(0.05, 0.02, 3.0));  // looking down the axis
+  auto observe = [&](const ObjectMap& m) {
+    std::vector<Observation> obs;
+    for (const MapObject& o : m.objects) {
+      const Projection p = project(o.ellipsoid, K, truth);
+      Observation ob;
+      ob.category = o.category;
+      ob.ellipse = p.ellipse;
+      ob.box = p.ellipse.boundingBox();
+      obs.push_back(ob);
+    }
+    return obs;
+  };
+  const RelocalizationResult sym = ObjectRelocalizer(map, K).relocalize(observe(map));
+  ASSERT_EQ(sym.status, RelocalizationStatus::Success);
+  EXPECT_EQ(sym.inliers.size(), 4u);  // some symmetric copy of the pose explains all four
+  EXPECT_NEAR((sym.pose.center() - Eigen::Vector3d(0, 0, 0)).norm(), truth.center().norm(), 0.05);
+  // A distinct object (a tv off the axis) breaks the symmetry: now the true pose wins.
+  map.objects.push_back({9, 62, "tv", Ellipsoid({0.9, 0.2, 0.1}, {0.25, 0.03, 0.18}, I)});
+  const RelocalizationResult r = ObjectRelocalizer(map, K).relocalize(observe(map));
+  ASSERT_EQ(r.status, RelocalizationStatus::Success);
+  EXPECT_LT((r.pose.center() - truth.center()).norm(), 0.01);
+  EXPECT_LT(rotationErrorDeg(r.pose.rotation(), truth.rotation()), 0.2);
+  for (const ObjectCorrespondence& c : r.inliers) EXPECT_EQ(c.object, c.observation);
+}
