@@ -1,6 +1,6 @@
-// Uses both the header-only core and the compiled library from an installed package.
-#include <ellreloc/core.hpp>
-#include <ellreloc/io/map.hpp>
+// Uses both the header-only core and the compiled library from an installed package, through
+// the umbrella header (so every installed header must compile).
+#include <ellreloc/ellreloc.hpp>
 
 #include <cstdio>
 #include <filesystem>

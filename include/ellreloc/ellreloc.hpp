@@ -1,0 +1,28 @@
+#pragma once
+/// \file ellreloc.hpp
+/// Everything: the geometry core, observations, pose estimation, file I/O and the simulator.
+/// Link ellreloc::ellreloc. (For the Eigen-only geometry alone, include ellreloc/core.hpp and
+/// link ellreloc::core.)
+
+#include "ellreloc/core.hpp"
+#include "ellreloc/core/object_map.hpp"
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/files.hpp"
+#include "ellreloc/io/map.hpp"
+#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/io/trajectory.hpp"
+#include "ellreloc/observe/ellipse_fit.hpp"
+#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/observe/observation.hpp"
+#include "ellreloc/observe/observe.hpp"
+#include "ellreloc/observe/regular_mask.hpp"
+#include "ellreloc/observe/rle.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/pose/p3p.hpp"
+#include "ellreloc/pose/ransac.hpp"
+#include "ellreloc/pose/wasserstein_refiner.hpp"
+#include "ellreloc/sim/noise.hpp"
+#include "ellreloc/sim/render.hpp"
+#include "ellreloc/sim/scene.hpp"
+#include "ellreloc/sim/writer.hpp"
