@@ -1,11 +1,11 @@
 #include "ellreloc/io/map.hpp"
 
+#include <cstdlib>
+#include <sstream>
+
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 #include "json_fields.hpp"
-
-#include <cstdlib>
-#include <sstream>
 
 namespace ellreloc::io {
 
@@ -32,14 +32,16 @@ Ellipsoid parseObjectGeometry(const json& obj, const Where& where) {
     const json& rot = detail::member(obj, "rotation", where);
     if (!rot.is_array() || rot.size() != 3) where["rotation"].fail("expected 3 rows of 3 numbers");
     Eigen::Matrix3d R;
-    for (size_t r = 0; r < 3; ++r) R.row(static_cast<int>(r)) = detail::vector<3>(rot[r], where["rotation"][r]).transpose();
+    for (size_t r = 0; r < 3; ++r)
+      R.row(static_cast<int>(r)) = detail::vector<3>(rot[r], where["rotation"][r]).transpose();
     if (!isRotation(R, kRotationTolerance)) where["rotation"].fail("not a rotation matrix (orthonormal, det +1)");
     return Ellipsoid(c, axes, nearestRotation(R));
   }
   const json& q = obj["dual_quadric"];
   if (!q.is_array() || q.size() != 16) where["dual_quadric"].fail("expected 16 numbers (row-major)");
   Eigen::Matrix4d Q;
-  for (size_t i = 0; i < 16; ++i) Q(static_cast<int>(i / 4), static_cast<int>(i % 4)) = detail::finiteNumber(q[i], where["dual_quadric"][i]);
+  for (size_t i = 0; i < 16; ++i)
+    Q(static_cast<int>(i / 4), static_cast<int>(i % 4)) = detail::finiteNumber(q[i], where["dual_quadric"][i]);
   return ellipsoidFromDualQuadric(Q, where["dual_quadric"]);
 }
 
@@ -51,7 +53,8 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
   if (!j.is_object()) top.fail("expected a JSON object with \"objects\"");
   if (j.contains("ellreloc_map")) {
     const int version = detail::integer(j["ellreloc_map"], top["ellreloc_map"]);
-    if (version != 1) top["ellreloc_map"].fail("unsupported version " + std::to_string(version) + " (this reader knows 1)");
+    if (version != 1)
+      top["ellreloc_map"].fail("unsupported version " + std::to_string(version) + " (this reader knows 1)");
   }
   const json& objects = detail::member(j, "objects", top);
   if (!objects.is_array()) top["objects"].fail("expected an array");
@@ -75,7 +78,8 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
       for (const auto& [key, value] : counts.items()) {
         char* end = nullptr;
         const long c = std::strtol(key.c_str(), &end, 10);
-        if (key.empty() || *end != '\0' || c < -2147483647L || c > 2147483647L) wc[key].fail("key is not an integer category");
+        if (key.empty() || *end != '\0' || c < -2147483647L || c > 2147483647L)
+          wc[key].fail("key is not an integer category");
         const double n = detail::finiteNumber(value, wc[key]);
         if (n < 0.0) wc[key].fail("count must be >= 0");
         obj.category_counts[static_cast<int>(c)] = n;
@@ -94,12 +98,7 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
 
 ObjectMap parseOaSlamMap(const std::string& text, const std::string& source) {
   ObjectMap map;
-  std::istringstream in(text);
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t\r")] == '#') continue;
+  forEachDataLine(text, [&](int line_no, const std::string& line) {
     const Where where{source, "line " + std::to_string(line_no)};
     std::istringstream fields(line);
     long long id = 0, category = 0;
@@ -118,7 +117,7 @@ ObjectMap parseOaSlamMap(const std::string& text, const std::string& source) {
     obj.category = static_cast<int>(category);
     obj.ellipsoid = ellipsoidFromDualQuadric(Q, where);
     map.objects.push_back(std::move(obj));
-  }
+  });
   if (map.objects.empty()) throw Error(source + ": no objects found (empty or blank map file)");
   return map;
 }

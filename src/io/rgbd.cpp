@@ -24,16 +24,9 @@ std::string resolve(const std::string& folder, const std::string& p) {
 }  // namespace
 
 std::vector<Association> readAssociations(const std::string& path) {
-  const std::string text = readTextFile(path);
   const std::string folder = folderOf(path);
-  std::istringstream in(text);
-  std::string line;
   std::vector<Association> out;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
+  forEachDataLine(readTextFile(path), [&](int line_no, const std::string& line) {
     std::istringstream fields(line);
     Association a;
     if (!(fields >> a.rgb_time >> a.rgb_path >> a.depth_time >> a.depth_path) || !std::isfinite(a.rgb_time) ||
@@ -42,7 +35,7 @@ std::vector<Association> readAssociations(const std::string& path) {
     a.rgb_path = resolve(folder, a.rgb_path);
     a.depth_path = resolve(folder, a.depth_path);
     out.push_back(std::move(a));
-  }
+  });
   if (out.empty()) throw Error(path + ": no associations found (empty file)");
   return out;
 }

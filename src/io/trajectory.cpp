@@ -1,26 +1,18 @@
 #include "ellreloc/io/trajectory.hpp"
 
-#include "ellreloc/error.hpp"
-#include "ellreloc/io/files.hpp"
-
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <iomanip>
 #include <sstream>
 
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/files.hpp"
+
 namespace ellreloc::io {
 
 std::vector<StampedPose> readTumTrajectory(const std::string& path) {
-  const std::string text = readTextFile(path);
-  std::istringstream in(text);
-  std::string line;
   std::vector<StampedPose> poses;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
+  forEachDataLine(readTextFile(path), [&](int line_no, const std::string& line) {
     const std::string where = path + ": line " + std::to_string(line_no) + ": ";
     std::istringstream fields(line);
     double v[8];
@@ -34,7 +26,7 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path) {
     if (!(q.norm() > 1e-6)) throw Error(where + "zero quaternion");
     q.normalize();
     poses.push_back({v[0], Pose::fromCameraToWorld(q.toRotationMatrix(), Eigen::Vector3d(v[1], v[2], v[3]))});
-  }
+  });
   if (poses.empty()) throw Error(path + ": no poses found (empty trajectory)");
   return poses;
 }
