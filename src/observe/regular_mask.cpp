@@ -10,30 +10,6 @@ namespace {
 
 using Point = Eigen::Vector2d;
 
-/// Calls f(x, y0, length) for every vertical segment of ones (runs split at column ends),
-/// walking the runs with counters instead of 64-bit divisions.
-template <typename F>
-void forEachRunSegment(const RleMask& rle, F f) {
-  int x = 0, y = 0;
-  const int h = rle.height;
-  for (size_t i = 0; i < rle.counts.size(); ++i) {
-    uint64_t remaining = rle.counts[i];
-    if (i % 2 == 0) {  // zeros: just advance
-      x += static_cast<int>(remaining / static_cast<uint64_t>(h));
-      y += static_cast<int>(remaining % static_cast<uint64_t>(h));
-      if (y >= h) y -= h, ++x;
-      continue;
-    }
-    while (remaining > 0) {
-      const int len = static_cast<int>(std::min<uint64_t>(remaining, static_cast<uint64_t>(h - y)));
-      f(x, y, len);
-      y += len;
-      remaining -= static_cast<uint64_t>(len);
-      if (y == h) y = 0, ++x;
-    }
-  }
-}
-
 double cross(const Point& o, const Point& a, const Point& b) {
   return (a(0) - o(0)) * (b(1) - o(1)) - (a(1) - o(1)) * (b(0) - o(0));
 }

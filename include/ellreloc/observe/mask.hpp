@@ -47,16 +47,9 @@ struct BinaryMask {
 inline std::optional<BinaryMask> decodeMask(const RleMask& rle) {
   if (!rle.isConsistent()) return std::nullopt;
   BinaryMask m(rle.height, rle.width);
-  uint64_t pos = 0;
-  for (size_t i = 0; i < rle.counts.size(); ++i) {
-    if (i % 2 == 1) {
-      for (uint64_t k = pos; k < pos + rle.counts[i]; ++k) {
-        const int x = static_cast<int>(k / rle.height), y = static_cast<int>(k % rle.height);
-        m.at(x, y) = 1;
-      }
-    }
-    pos += rle.counts[i];
-  }
+  forEachRunSegment(rle, [&m](int x, int y0, int len) {
+    for (int y = y0; y < y0 + len; ++y) m.at(x, y) = 1;
+  });
   return m;
 }
 
@@ -64,39 +57,20 @@ inline std::optional<BinaryMask> decodeMask(const RleMask& rle) {
 /// the work is proportional to the object, not to the image. nullopt when inconsistent or empty.
 inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle) {
   if (!rle.isConsistent()) return std::nullopt;
-  const uint64_t h = static_cast<uint64_t>(rle.height);
-  uint64_t pos = 0, first = std::numeric_limits<uint64_t>::max(), last = 0;
-  int ymin = rle.height, ymax = -1;
-  for (size_t i = 0; i < rle.counts.size(); ++i) {
-    if (i % 2 == 1 && rle.counts[i] > 0) {
-      first = std::min(first, pos);
-      last = pos + rle.counts[i] - 1;
-      // A run within one column covers rows y0..y1; across columns it covers every row.
-      if (pos / h == last / h) {
-        ymin = std::min<int>(ymin, static_cast<int>(pos % h));
-        ymax = std::max<int>(ymax, static_cast<int>(last % h));
-      } else {
-        ymin = 0;
-        ymax = rle.height - 1;
-      }
-    }
-    pos += rle.counts[i];
-  }
-  if (first == std::numeric_limits<uint64_t>::max()) return std::nullopt;
-  const int xmin = static_cast<int>(first / h), xmax = static_cast<int>(last / h);
+  int xmin = rle.width, xmax = -1, ymin = rle.height, ymax = -1;
+  forEachRunSegment(rle, [&](int x, int y0, int len) {
+    xmin = std::min(xmin, x), xmax = std::max(xmax, x);
+    ymin = std::min(ymin, y0), ymax = std::max(ymax, y0 + len - 1);
+  });
+  if (xmax < 0) return std::nullopt;
   BinaryMask m(ymax - ymin + 1, xmax - xmin + 1);
   m.x0 = xmin;
   m.y0 = ymin;
   m.image_width = rle.width;
   m.image_height = rle.height;
-  pos = 0;
-  for (size_t i = 0; i < rle.counts.size(); ++i) {
-    if (i % 2 == 1) {
-      for (uint64_t k = pos; k < pos + rle.counts[i]; ++k)
-        m.at(static_cast<int>(k / h) - xmin, static_cast<int>(k % h) - ymin) = 1;
-    }
-    pos += rle.counts[i];
-  }
+  forEachRunSegment(rle, [&](int x, int y0, int len) {
+    for (int y = y0; y < y0 + len; ++y) m.at(x - xmin, y - ymin) = 1;
+  });
   return m;
 }
 
@@ -132,40 +106,27 @@ struct MaskMoments {
   Box bounds;  ///< outer pixel edges of the mask, FORMATS convention
 };
 
-/// Moments straight from the runs, without decoding: a run of ones in column x from y0 to y1
-/// adds n = y1 - y0 + 1 pixels with known sums of y and y^2. O(number of runs).
+/// Moments straight from the runs, without decoding: a segment of ones in column x from y0 to
+/// y1 adds n = y1 - y0 + 1 pixels with known sums of y and y^2. O(number of runs).
 inline std::optional<MaskMoments> rleMoments(const RleMask& rle) {
   if (!rle.isConsistent()) return std::nullopt;
   long double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
   double x1 = 1e300, y1 = 1e300, x2 = -1e300, y2 = -1e300;
-  uint64_t pos = 0;
-  const uint64_t h = static_cast<uint64_t>(rle.height);
-  for (size_t i = 0; i < rle.counts.size(); ++i) {
-    uint64_t start = pos, remaining = rle.counts[i];
-    pos += rle.counts[i];
-    if (i % 2 == 0) continue;
-    while (remaining > 0) {  // a run may continue into the next columns
-      const long double x = static_cast<long double>(start / h);
-      const uint64_t y0 = start % h;
-      const uint64_t len = std::min<uint64_t>(remaining, h - y0);
-      const long double a = static_cast<long double>(y0), b = static_cast<long double>(y0 + len - 1);
-      const long double cnt = static_cast<long double>(len);
-      const long double sum_y = cnt * (a + b) / 2;
-      const long double sum_y2 = (b * (b + 1) * (2 * b + 1) - (a - 1) * a * (2 * a - 1)) / 6;
-      n += cnt;
-      sx += cnt * x;
-      sxx += cnt * x * x;
-      sy += sum_y;
-      syy += sum_y2;
-      sxy += x * sum_y;
-      x1 = std::min(x1, static_cast<double>(x));
-      x2 = std::max(x2, static_cast<double>(x));
-      y1 = std::min(y1, static_cast<double>(a));
-      y2 = std::max(y2, static_cast<double>(b));
-      start += len;
-      remaining -= len;
-    }
-  }
+  forEachRunSegment(rle, [&](int xi, int y0, int len) {
+    const long double x = xi, a = y0, b = y0 + len - 1, cnt = len;
+    const long double sum_y = cnt * (a + b) / 2;
+    const long double sum_y2 = (b * (b + 1) * (2 * b + 1) - (a - 1) * a * (2 * a - 1)) / 6;
+    n += cnt;
+    sx += cnt * x;
+    sxx += cnt * x * x;
+    sy += sum_y;
+    syy += sum_y2;
+    sxy += x * sum_y;
+    x1 = std::min(x1, static_cast<double>(x));
+    x2 = std::max(x2, static_cast<double>(x));
+    y1 = std::min(y1, static_cast<double>(a));
+    y2 = std::max(y2, static_cast<double>(b));
+  });
   if (n <= 0) return std::nullopt;
   MaskMoments m;
   m.area = static_cast<double>(n);

@@ -5,6 +5,7 @@
 /// each run (from the fourth on, minus the run two before) in 5-bit groups, 0x20 = "more",
 /// offset by 48 (pycocotools' rleToString / rleFrString).
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -27,6 +28,32 @@ struct RleMask {
     return height > 0 && width > 0 && totalPixels() == static_cast<uint64_t>(height) * static_cast<uint64_t>(width);
   }
 };
+
+/// Calls f(x, y0, length) for every vertical segment of ones of a consistent mask (runs split
+/// where they wrap into the next column), in column-major order, walking the runs with
+/// counters instead of a division per run.
+template <typename F>
+void forEachRunSegment(const RleMask& rle, F f) {
+  if (rle.height <= 0) return;
+  int x = 0, y = 0;
+  const int h = rle.height;
+  for (size_t i = 0; i < rle.counts.size(); ++i) {
+    uint64_t remaining = rle.counts[i];
+    if (i % 2 == 0) {  // zeros: just advance
+      x += static_cast<int>(remaining / static_cast<uint64_t>(h));
+      y += static_cast<int>(remaining % static_cast<uint64_t>(h));
+      if (y >= h) y -= h, ++x;
+      continue;
+    }
+    while (remaining > 0) {
+      const int len = static_cast<int>(std::min<uint64_t>(remaining, static_cast<uint64_t>(h - y)));
+      f(x, y, len);
+      y += len;
+      remaining -= static_cast<uint64_t>(len);
+      if (y == h) y = 0, ++x;
+    }
+  }
+}
 
 /// Encodes run lengths as pycocotools' compressed string.
 inline std::string encodeRleString(const std::vector<uint32_t>& counts) {
