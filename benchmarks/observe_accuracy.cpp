@@ -124,11 +124,7 @@ int main() {
     // Look near the object, sometimes far enough off to cut it at the image border.
     const Eigen::Vector3d target =
         Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) * (u(rng) < 0.2 ? 0.9 : 0.2) * dist;
-    Eigen::Matrix3d R_wc;
-    R_wc.col(2) = (target - centre).normalized();
-    R_wc.col(0) = R_wc.col(2).cross(Eigen::Vector3d::UnitZ()).normalized();
-    R_wc.col(1) = R_wc.col(2).cross(R_wc.col(0));
-    const Pose pose = Pose::fromCameraToWorld(R_wc, centre);
+    const Pose pose = Pose::lookAt(centre, target);
     const Projection truth = project(Ellipsoid(Eigen::Vector3d::Zero(), half, R), kK, pose);
     BinaryMask mask;
     if (!truth || !render(parts, pose, &mask) || mask.count() < 200) continue;

@@ -34,11 +34,8 @@ inline Room makeRoom(int n, int categories, int cameras, uint32_t seed) {
   while (static_cast<int>(room.cameras.size()) < cameras) {
     const double a = 6.28 * u(rng);
     const Eigen::Vector3d c(2.8 * std::cos(a), 2.8 * std::sin(a), 1.2 + 0.4 * u(rng));
-    const Eigen::Vector3d z = (Eigen::Vector3d(0.3 * u(rng), 0.3 * u(rng), 0.4) - c).normalized();
-    const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-    Eigen::Matrix3d R_wc;
-    R_wc << x, z.cross(x), z;
-    room.cameras.push_back(Pose::fromCameraToWorld(R_wc, c));
+    const Eigen::Vector3d target(0.3 * u(rng), 0.3 * u(rng), 0.4);
+    room.cameras.push_back(Pose::lookAt(c, target));
   }
   return room;
 }

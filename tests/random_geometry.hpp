@@ -1,11 +1,10 @@
 #pragma once
 // Seeded random geometry shared by the tests.
 
-#include "ellreloc/core.hpp"
-
 #include <Eigen/Geometry>
-
 #include <random>
+
+#include "ellreloc/core.hpp"
 
 namespace ellreloc::test {
 
@@ -30,17 +29,11 @@ inline Ellipsoid randomEllipsoid(std::mt19937& rng) {
 
 /// A camera 2.5-4 m from the origin looking at a point near it (up = world z).
 inline Pose randomLookAtPose(std::mt19937& rng) {
-  const Eigen::Vector3d center = Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -0.5, 0.5))
-                                     .normalized() * uniform(rng, 2.5, 4.0);
+  const Eigen::Vector3d center =
+      Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -0.5, 0.5)).normalized() *
+      uniform(rng, 2.5, 4.0);
   const Eigen::Vector3d target(uniform(rng, -0.2, 0.2), uniform(rng, -0.2, 0.2), uniform(rng, -0.2, 0.2));
-  const Eigen::Vector3d z = (target - center).normalized();
-  Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ());
-  if (x.norm() < 1e-6) x = Eigen::Vector3d::UnitX();
-  x.normalize();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Matrix3d R_wc;
-  R_wc << x, y, z;
-  return Pose::fromCameraToWorld(R_wc, center);
+  return Pose::lookAt(center, target);
 }
 
 inline Intrinsics testIntrinsics() { return Intrinsics(525.0, 520.0, 319.5, 239.5, 640, 480); }

@@ -34,11 +34,8 @@ int main(int argc, char** argv) try {
     for (const auto& [category, e] : desk)
       map.objects.push_back({static_cast<int>(map.objects.size()), category, "", e});
     // What a detector sees from a camera 1.5 m in front of the desk: one box per object.
-    Eigen::Matrix3d R_wc;
-    R_wc.col(2) = Eigen::Vector3d(0.3, 1.4, -0.6).normalized();              // optical axis
-    R_wc.col(0) = R_wc.col(2).cross(Eigen::Vector3d::UnitZ()).normalized();  // image x
-    R_wc.col(1) = R_wc.col(2).cross(R_wc.col(0));                            // image y, down
-    const Pose truth = Pose::fromCameraToWorld(R_wc, {-0.4, -1.5, 1.4});
+    const Eigen::Vector3d eye(-0.4, -1.5, 1.4);
+    const Pose truth = Pose::lookAt(eye, eye + Eigen::Vector3d(0.3, 1.4, -0.6));
     for (const MapObject& m : map.objects)
       if (const Projection p = project(m.ellipsoid, K, truth))
         observations.push_back(*observationFromBox(m.category, 0.9, p.ellipse.boundingBox(), K.width, K.height));

@@ -216,26 +216,12 @@ Scene makeScene(ScenePreset preset, uint64_t seed) {
   return scene;
 }
 
-namespace {
-
-Pose lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  Eigen::Matrix3d R_wc;
-  R_wc.col(2) = (target - eye).normalized();
-  Eigen::Vector3d x = R_wc.col(2).cross(Eigen::Vector3d::UnitZ());
-  if (x.norm() < 1e-6) x = Eigen::Vector3d::UnitX();
-  R_wc.col(0) = x.normalized();
-  R_wc.col(1) = R_wc.col(2).cross(R_wc.col(0));
-  return Pose::fromCameraToWorld(R_wc, eye);
-}
-
-}  // namespace
-
 std::vector<Pose> mappingTrajectory(const Scene& scene, int frames) {
   std::vector<Pose> poses;
   const double r = std::min(2.2, scene.room_half_size - 0.2);
   for (int i = 0; i < frames; ++i) {
     const double a = 2.0 * M_PI * i / std::max(1, frames);
-    poses.push_back(lookAt(Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 1.4), Eigen::Vector3d(0, 0, 0.6)));
+    poses.push_back(Pose::lookAt(Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 1.4), Eigen::Vector3d(0, 0, 0.6)));
   }
   return poses;
 }
@@ -250,7 +236,7 @@ std::vector<Pose> queryTrajectory(const Scene& scene, int frames, uint64_t seed)
     const double r = 1.5 + (r_max - 1.5) * u(rng);
     const double h = 0.8 + 1.2 * u(rng);
     const Eigen::Vector3d target(0.5 * (u(rng) - 0.5), 0.5 * (u(rng) - 0.5), 0.3 + 0.6 * u(rng));
-    poses.push_back(lookAt(Eigen::Vector3d(r * std::cos(a), r * std::sin(a), h), target));
+    poses.push_back(Pose::lookAt(Eigen::Vector3d(r * std::cos(a), r * std::sin(a), h), target));
   }
   return poses;
 }

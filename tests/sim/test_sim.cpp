@@ -15,14 +15,6 @@ namespace {
 
 const Intrinsics kK(525.0, 525.0, 319.5, 239.5, 640, 480);
 
-Pose lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  Eigen::Matrix3d R_wc;
-  R_wc.col(2) = (target - eye).normalized();
-  R_wc.col(0) = R_wc.col(2).cross(Eigen::Vector3d::UnitZ()).normalized();
-  R_wc.col(1) = R_wc.col(2).cross(R_wc.col(0));
-  return Pose::fromCameraToWorld(R_wc, eye);
-}
-
 }  // namespace
 
 TEST(Scene, PresetsAreDeterministicAndPlausible) {
@@ -92,7 +84,7 @@ TEST(Render, AnEllipsoidsMaskIsItsProjectedEllipse) {
   s.objects.push_back(o);
   for (const Eigen::Vector3d& eye :
        {Eigen::Vector3d(2, -1, 1.5), Eigen::Vector3d(-1.5, -1.5, 0.5), Eigen::Vector3d(0, 2, 2.5)}) {
-    const Pose pose = lookAt(eye, o.box_center);
+    const Pose pose = Pose::lookAt(eye, o.box_center);
     const RenderedFrame f = render(s, kK, pose);
     const Projection p = project(o.ellipsoid(), kK, pose);
     ASSERT_TRUE(p.ok());
@@ -121,7 +113,7 @@ TEST(Render, OcclusionDepthAndClipping) {
   near_box.parts.push_back({PrimitiveShape::Box, Eigen::Vector3d(0, -1.0, 1.0), Eigen::Vector3d(0.1, 0.1, 0.1), I});
   far_box.parts.push_back({PrimitiveShape::Box, Eigen::Vector3d(0.15, 0.0, 1.0), Eigen::Vector3d(0.2, 0.2, 0.2), I});
   s.objects = {near_box, far_box};
-  const Pose pose = lookAt(Eigen::Vector3d(0, -3.0, 1.0), Eigen::Vector3d(0, 0, 1.0));
+  const Pose pose = Pose::lookAt(Eigen::Vector3d(0, -3.0, 1.0), Eigen::Vector3d(0, 0, 1.0));
   const RenderedFrame f = render(s, kK, pose);
   // Centre pixel: the near box's front face, 1.9 m away (analytic).
   EXPECT_EQ(f.instanceAt(319, 239), 0);

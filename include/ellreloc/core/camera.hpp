@@ -2,12 +2,11 @@
 /// \file camera.hpp
 /// Pinhole intrinsics and world->camera poses (x_c = R_cw x_w + t_cw, as ORB-SLAM's Tcw).
 
-#include "ellreloc/core/ellipsoid.hpp"
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <cmath>
+
+#include "ellreloc/core/ellipsoid.hpp"
 
 namespace ellreloc {
 
@@ -22,8 +21,8 @@ struct Intrinsics {
 
   /// Finite, positive focal lengths and a positive image size.
   bool isValid() const {
-    return std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) && std::isfinite(cy) && fx > 0 &&
-           fy > 0 && width > 0 && height > 0;
+    return std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) && std::isfinite(cy) && fx > 0 && fy > 0 &&
+           width > 0 && height > 0;
   }
 
   Eigen::Matrix3d K() const {
@@ -53,6 +52,20 @@ class Pose {
   /// trajectory files store it.
   static Pose fromCameraToWorld(const Eigen::Matrix3d& R_wc, const Eigen::Vector3d& center) {
     return Pose(R_wc.transpose(), -R_wc.transpose() * center);
+  }
+
+  /// A camera at `eye` looking at `target`, image x horizontal (perpendicular to `up` and the
+  /// optical axis), image y pointing away from `up` (down for up = world z).
+  static Pose lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                     const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ()) {
+    Eigen::Matrix3d R_wc;
+    R_wc.col(2) = (target - eye).normalized();
+    Eigen::Vector3d x = R_wc.col(2).cross(up);
+    if (x.norm() < 1e-6)
+      x = std::abs(R_wc(0, 2)) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();  // along `up`
+    R_wc.col(0) = x.normalized();
+    R_wc.col(1) = R_wc.col(2).cross(R_wc.col(0));
+    return fromCameraToWorld(R_wc, eye);
   }
 
   const Eigen::Matrix3d& rotation() const { return R_; }
