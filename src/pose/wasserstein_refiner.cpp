@@ -180,12 +180,10 @@ struct CeresObjectCost {
     const Eigen::Map<const Eigen::Quaternion<T>> quat(q);
     const Mat3<T> R = quat.normalized().toRotationMatrix();
     const Eigen::Matrix<T, 3, 1> tt(t[0], t[1], t[2]);
-    // Depth range of the ellipsoid: it must stay strictly in front of the camera.
-    const Eigen::Matrix<T, 3, 1> r3 = R.row(2).transpose();
-    using std::sqrt;
-    const T zc = r3.dot(c.cast<T>()) + tt(2);
-    const T half = sqrt(r3.dot(M.cast<T>() * r3));
-    if (!(zc - half > T(0))) return false;
+    // The ellipsoid must stay strictly in front of the camera (as in project()).
+    T near, far;
+    depthRange<T>(R, tt, c.cast<T>(), M.cast<T>(), &near, &far);
+    if (!(near > T(0))) return false;
     Eigen::Matrix<T, 3, 4> P;
     P << R, tt;
     P = K.cast<T>() * P;

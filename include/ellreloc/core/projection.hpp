@@ -3,14 +3,13 @@
 /// Projection of an ellipsoid into an image: C* = P Q* P^T (Hartley & Zisserman, eq. 8.9;
 /// the paper's eq. 7).
 
+#include <Eigen/Core>
+#include <cmath>
+#include <optional>
+
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/ellipsoid.hpp"
-
-#include <Eigen/Core>
-
-#include <cmath>
-#include <optional>
 
 namespace ellreloc {
 
@@ -18,6 +17,21 @@ namespace ellreloc {
 template <typename T>
 Mat3<T> projectDualQuadric(const Eigen::Matrix<T, 3, 4>& P, const Eigen::Matrix<T, 4, 4>& Q) {
   return P * Q * P.transpose();
+}
+
+/// Depth range [near, far] of an ellipsoid (centre c, shape matrix M = R diag(a^2) R^T) along
+/// the optical axis of a pose (R_cw, t_cw): z(c) -+ sqrt(r3^T M r3), r3 = third row of R_cw
+/// (the ellipsoid's support function). Its image is an ellipse exactly when near > 0.
+/// Templated for Ceres.
+template <typename T>
+void depthRange(const Mat3<T>& R_cw, const Eigen::Matrix<T, 3, 1>& t_cw, const Eigen::Matrix<T, 3, 1>& c,
+                const Mat3<T>& M, T* near, T* far) {
+  using std::sqrt;
+  const Eigen::Matrix<T, 3, 1> r3 = R_cw.row(2).transpose();
+  const T zc = r3.dot(c) + t_cw(2);
+  const T half = sqrt(r3.dot(M * r3));
+  *near = zc - half;
+  *far = zc + half;
 }
 
 enum class ProjectionStatus {
@@ -30,11 +44,16 @@ enum class ProjectionStatus {
 
 inline const char* toString(ProjectionStatus s) {
   switch (s) {
-    case ProjectionStatus::Ok: return "ok";
-    case ProjectionStatus::InvalidInput: return "invalid ellipsoid, intrinsics or pose";
-    case ProjectionStatus::ContainsCamera: return "camera centre inside the ellipsoid";
-    case ProjectionStatus::BehindCamera: return "ellipsoid behind the camera";
-    case ProjectionStatus::NotAnEllipse: return "ellipsoid crosses the principal plane; image is not an ellipse";
+    case ProjectionStatus::Ok:
+      return "ok";
+    case ProjectionStatus::InvalidInput:
+      return "invalid ellipsoid, intrinsics or pose";
+    case ProjectionStatus::ContainsCamera:
+      return "camera centre inside the ellipsoid";
+    case ProjectionStatus::BehindCamera:
+      return "ellipsoid behind the camera";
+    case ProjectionStatus::NotAnEllipse:
+      return "ellipsoid crosses the principal plane; image is not an ellipse";
   }
   return "unknown";
 }
@@ -58,16 +77,13 @@ inline Projection project(const Ellipsoid& ellipsoid, const Intrinsics& K, const
     out.status = ProjectionStatus::ContainsCamera;
     return out;
   }
-  // Depth range of the ellipsoid along the optical axis: z(centre) +- sqrt(r3^T M r3),
-  // r3 = third row of R_cw (support function of the ellipsoid).
-  const Eigen::Vector3d r3 = pose.rotation().row(2).transpose();
-  const double zc = r3.dot(ellipsoid.center()) + pose.translation()(2);
-  const double half_depth = std::sqrt(r3.dot(ellipsoid.shapeMatrix() * r3));
-  if (zc + half_depth <= 0.0) {
+  double near = 0.0, far = 0.0;
+  depthRange<double>(pose.rotation(), pose.translation(), ellipsoid.center(), ellipsoid.shapeMatrix(), &near, &far);
+  if (far <= 0.0) {
     out.status = ProjectionStatus::BehindCamera;
     return out;
   }
-  if (zc - half_depth <= 0.0) {
+  if (near <= 0.0) {
     out.status = ProjectionStatus::NotAnEllipse;
     return out;
   }
