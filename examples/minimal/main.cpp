@@ -11,6 +11,10 @@
 using namespace ellreloc;
 
 int main(int argc, char** argv) try {
+  if (argc != 1 && argc != 4) {
+    std::fprintf(stderr, "usage: %s [camera.yaml map.json detections.json]\n", argv[0]);
+    return 2;
+  }
   Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   ObjectMap map;
   std::vector<Observation> observations;
