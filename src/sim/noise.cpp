@@ -78,6 +78,24 @@ RleMask morphNoise(const RleMask& rle, int max_px, std::mt19937_64& rng) {
   return encodeMask(noisy);
 }
 
+/// Toggles round(rate x area) pixels drawn uniformly in the mask's box grown by 2 pixels:
+/// holes inside the object and specks around it, as a segmentation network's pixel errors.
+RleMask flipPixels(const RleMask& rle, double rate, std::mt19937_64& rng) {
+  auto m = decodeMask(rle);
+  const auto moments = rleMoments(rle);
+  if (!m || !moments || !(rate > 0.0)) return rle;
+  const int x1 = std::max(0, static_cast<int>(moments->bounds.x1 + 0.5) - 2);
+  const int y1 = std::max(0, static_cast<int>(moments->bounds.y1 + 0.5) - 2);
+  const int x2 = std::min(m->width - 1, static_cast<int>(moments->bounds.x2 - 0.5) + 2);
+  const int y2 = std::min(m->height - 1, static_cast<int>(moments->bounds.y2 - 0.5) + 2);
+  std::uniform_int_distribution<int> ux(x1, x2), uy(y1, y2);
+  for (long k = std::lround(rate * moments->area); k > 0; --k) {
+    uint8_t& px = m->at(ux(rng), uy(rng));
+    px = px ? 0 : 1;
+  }
+  return encodeMask(*m);
+}
+
 }  // namespace
 
 std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, const NoiseModel& noise,
@@ -94,6 +112,7 @@ std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, co
       d.category_id = scene.objects[(j + 1 + static_cast<size_t>(u(rng) * 7)) % scene.objects.size()].category;
     d.score = std::clamp(0.6 + 0.35 * u(rng), 0.0, 1.0);
     d.mask = noise.mask_boundary_px > 0 ? morphNoise(frame.masks[j], noise.mask_boundary_px, rng) : frame.masks[j];
+    if (noise.mask_flip_rate > 0.0) d.mask = flipPixels(*d.mask, noise.mask_flip_rate, rng);
     const auto moments = rleMoments(*d.mask);
     if (!moments) continue;  // eroded away
     const Box& b = moments->bounds;

@@ -21,6 +21,7 @@ enum class NoiseLevel { None, Realistic, Hard };
 
 struct NoiseModel {
   int mask_boundary_px = 0;         ///< masks eroded or dilated by up to this many pixels
+  double mask_flip_rate = 0.0;      ///< pixels toggled around each mask, as a share of its area
   double box_jitter_px = 0.0;       ///< standard deviation of each box edge
   double miss_rate = 0.0;           ///< share of visible objects not detected
   double false_positives = 0.0;     ///< expected false detections per frame

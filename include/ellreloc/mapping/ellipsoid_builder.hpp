@@ -1,0 +1,130 @@
+#pragma once
+/// \file ellipsoid_builder.hpp
+/// The paper's "Accurate Ellipsoids Generation": objects stand on the ground, so their pose
+/// reduces to a yaw about gravity. The yaw is the main axis of a PCA of the object's voxels
+/// projected onto the ground plane; extents along the two ground axes and gravity come from
+/// robust percentiles of the voxel coordinates; the ellipsoid is the one inscribed in that
+/// cuboid (eqs. 5-6: Q* = Z^T diag(l^2/4, w^2/4, h^2/4, -1) Z).
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "ellreloc/core/ellipsoid.hpp"
+
+namespace ellreloc {
+
+/// An oriented cuboid: centre, half-extents along its axes, rotation (cuboid -> world).
+struct Cuboid {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d half = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+
+  /// The eight corners, for display.
+  std::array<Eigen::Vector3d, 8> corners() const {
+    std::array<Eigen::Vector3d, 8> c;
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d s((i & 1) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 4) ? 1.0 : -1.0);
+      c[static_cast<size_t>(i)] = center + rotation * s.cwiseProduct(half);
+    }
+    return c;
+  }
+  /// The inscribed ellipsoid (semi-axes = half-extents).
+  Ellipsoid inscribedEllipsoid() const { return Ellipsoid(center, half, rotation); }
+};
+
+struct EllipsoidBuilderOptions {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< against gravity, in world coordinates
+  /// Extents span these percentiles of the voxel coordinates along each axis, which ignores
+  /// a few outlier voxels that survived the label filter.
+  double low_percentile = 0.01;
+  double high_percentile = 0.99;
+  /// Added to each half-extent. Voxel centres lie within half a voxel of the surface, on
+  /// either side, so the percentile span needs no padding by default.
+  double extent_padding = 0.0;
+  size_t min_points = 8;  ///< fewer voxels: no ellipsoid
+};
+
+struct BuiltEllipsoid {
+  Ellipsoid ellipsoid;
+  Cuboid cuboid;
+  double yaw = 0.0;  ///< radians, of the cuboid's first axis in the ground plane
+};
+
+namespace detail {
+/// The q-quantile of values (0 <= q <= 1), linear interpolation between order statistics.
+inline double quantile(std::vector<double> values, double q) {
+  const double pos = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(lo), values.end());
+  const double a = values[lo];
+  if (lo + 1 >= values.size()) return a;
+  const double b = *std::min_element(values.begin() + static_cast<long>(lo) + 1, values.end());
+  return a + (pos - static_cast<double>(lo)) * (b - a);
+}
+}  // namespace detail
+
+/// A right-handed world basis (e1, e2, up) with e1, e2 spanning the ground plane.
+inline Eigen::Matrix3d groundBasis(const Eigen::Vector3d& up) {
+  const Eigen::Vector3d g = up.normalized();
+  const Eigen::Vector3d helper = std::abs(g.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d e1 = (helper - helper.dot(g) * g).normalized();
+  Eigen::Matrix3d B;
+  B << e1, g.cross(e1), g;
+  return B;
+}
+
+/// Builds the yaw-only cuboid and its inscribed ellipsoid from an object's voxel centres
+/// (world coordinates). nullopt with fewer than options.min_points points, a zero or
+/// non-finite `up`, or a degenerate (flat) point set.
+inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vector3d>& points,
+                                                    const EllipsoidBuilderOptions& options = {}) {
+  if (points.size() < std::max<size_t>(options.min_points, 4) || !options.up.allFinite() ||
+      !(options.up.norm() > 1e-12))
+    return std::nullopt;
+  const Eigen::Matrix3d B = groundBasis(options.up);
+
+  // PCA of the ground-plane projections: the main axis gives the yaw.
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : points) mean += (B.leftCols<2>().transpose() * p);
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const auto& p : points) {
+    const Eigen::Vector2d d = B.leftCols<2>().transpose() * p - mean;
+    cov += d * d.transpose();
+  }
+  if (!cov.allFinite()) return std::nullopt;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  const Eigen::Vector2d main = eig.eigenvectors().col(1);  // largest eigenvalue
+  const double yaw = std::atan2(main.y(), main.x());
+
+  Eigen::Matrix3d R;  // cuboid -> world: main ground axis, the other ground axis, up
+  R.col(0) = B.leftCols<2>() * main;
+  R.col(2) = B.col(2);
+  R.col(1) = R.col(2).cross(R.col(0));
+
+  Cuboid cuboid;
+  cuboid.rotation = R;
+  Eigen::Vector3d local_center;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> coords(points.size());
+    for (size_t i = 0; i < points.size(); ++i) coords[i] = R.col(axis).dot(points[i]);
+    const double lo = detail::quantile(coords, options.low_percentile);
+    const double hi = detail::quantile(coords, options.high_percentile);
+    local_center(axis) = 0.5 * (lo + hi);
+    cuboid.half(axis) = 0.5 * (hi - lo) + options.extent_padding;
+  }
+  if (!(cuboid.half.minCoeff() > 0.0) || !cuboid.half.allFinite()) return std::nullopt;
+  cuboid.center = R * local_center;
+  BuiltEllipsoid out;
+  out.cuboid = cuboid;
+  out.ellipsoid = cuboid.inscribedEllipsoid();
+  out.yaw = yaw;
+  return out;
+}
+
+}  // namespace ellreloc

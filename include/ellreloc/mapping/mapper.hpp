@@ -1,0 +1,129 @@
+#pragma once
+/// \file mapper.hpp
+/// The object mapper: keyframes in one by one, the current object map out at any time.
+///
+/// Voxel mode (the paper, RGB-D): each detection's mask and the keyframe's depth update a
+/// voxel object (voxel_object.hpp); detections are tracked in 2D against the objects seen in
+/// the last keyframes and matched in 3D against the whole map (object_tracker.hpp); an object
+/// enters the map after `min_observations` (omega0 = 3) observations, its label is its most
+/// frequent category, its low-probability voxels are pruned at every update, and its
+/// ellipsoid comes from the PCA yaw builder (ellipsoid_builder.hpp).
+/// Boxes mode (monocular): detections are tracked by their boxes, and each object's ellipsoid
+/// is fitted to its boxes (box_ellipsoid_builder.hpp).
+///
+/// Reads (map(), objects(), stats()) may run on other threads while keyframes are added.
+
+#include <map>
+#include <optional>
+#include <shared_mutex>
+#include <string>
+#include <vector>
+
+#include "ellreloc/core/camera.hpp"
+#include "ellreloc/core/object_map.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/mapping/box_ellipsoid_builder.hpp"
+#include "ellreloc/mapping/ellipsoid_builder.hpp"
+#include "ellreloc/mapping/object_tracker.hpp"
+#include "ellreloc/mapping/voxel_object.hpp"
+
+namespace ellreloc {
+
+enum class MappingMode {
+  Voxel,  ///< RGB-D keyframes with masks (a detection without a mask uses its box)
+  Boxes,  ///< boxes and poses only
+};
+const char* toString(MappingMode mode);
+bool parseMappingMode(const std::string& name, MappingMode* mode);
+
+struct MapperOptions {
+  MappingMode mode = MappingMode::Voxel;
+  VoxelOptions voxels;
+  TrackingOptions tracking;
+  EllipsoidBuilderOptions ellipsoid;
+  BoxEllipsoidOptions boxes;
+  int min_observations = 3;        ///< omega0: observations before an object enters the map
+  double prune_probability = 0.5;  ///< map objects lose voxels below this at each update
+  /// Voxels enter the ellipsoid from this probability on: 0.75 needs two hits more than a
+  /// miss, so a voxel hit by a single stray mask pixel stays out.
+  double ellipsoid_min_probability = 0.75;
+  int track_window = 1;         ///< 2D tracking against objects seen in the last N keyframes
+  int candidate_lifetime = 10;  ///< objects not yet in the map are forgotten after N keyframes unseen
+  double min_score = 0.0;       ///< detections below this score are ignored
+  long min_mask_pixels = 30;    ///< smaller masks are ignored
+};
+
+/// What one keyframe did.
+struct KeyframeReport {
+  int used = 0;         ///< detections integrated
+  int tracked_2d = 0;   ///< associated by 2D tracking
+  int matched_3d = 0;   ///< associated by 3D voxel matching
+  int new_objects = 0;  ///< started a new object
+  int ignored = 0;      ///< below min_score or min_mask_pixels
+};
+
+/// A mapped object with what the mapper knows about it.
+struct MappedObject {
+  MapObject object;              ///< id, category, label histogram, ellipsoid
+  std::optional<Cuboid> cuboid;  ///< voxel mode: the yaw-aligned cuboid the ellipsoid is inscribed in
+  int observations = 0;
+  size_t voxels = 0;        ///< voxel mode: voxels held
+  size_t memory_bytes = 0;  ///< voxel mode: heap memory of its voxels
+};
+
+struct MapperStats {
+  int keyframes = 0;
+  int objects = 0;     ///< in the map
+  int candidates = 0;  ///< seen fewer than min_observations times
+  size_t voxels = 0;
+  size_t memory_bytes = 0;
+};
+
+class Mapper {
+ public:
+  /// Throws ellreloc::Error for invalid intrinsics or options.
+  explicit Mapper(const Intrinsics& K, const MapperOptions& options = {});
+
+  /// Adds a keyframe: world->camera pose, detections (boxes; masks in voxel mode), and the depth
+  /// image in metres (voxel mode; ignored in boxes mode). Throws ellreloc::Error naming the
+  /// problem for a non-finite pose, a missing, mis-sized or empty depth image, or a mask whose
+  /// size differs from the camera's; the map is then left unchanged.
+  KeyframeReport addKeyframe(const Pose& pose, const std::vector<Detection>& detections,
+                             const io::DepthImage* depth = nullptr);
+
+  /// The objects in the map (those with an ellipsoid), in the order they were created.
+  ObjectMap map() const;
+  std::vector<MappedObject> objects() const;
+  MapperStats stats() const;
+  const Intrinsics& intrinsics() const { return K_; }
+  const MapperOptions& options() const { return options_; }
+
+ private:
+  struct Track {
+    int id = 0;
+    VoxelObject voxels;
+    std::vector<BoxView> views;  // boxes mode
+    std::map<int, double> labels;
+    int observations = 0;
+    int last_seen = -1;
+    bool confirmed = false;
+    std::optional<MappedObject> built;  // rebuilt after each update of a confirmed object
+    int label() const;
+  };
+  void checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const io::DepthImage* depth) const;
+  void addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const io::DepthImage& depth,
+                        KeyframeReport* report);
+  void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report);
+  void observed(Track& track, const Detection& detection);
+  void rebuild(Track& track) const;
+
+  Intrinsics K_;
+  MapperOptions options_;
+  mutable std::shared_mutex mutex_;
+  std::vector<Track> tracks_;
+  int keyframes_ = 0;
+  int next_id_ = 0;
+};
+
+}  // namespace ellreloc

@@ -1,0 +1,132 @@
+#pragma once
+/// \file voxel_object.hpp
+/// One object of the voxel map (Zhu et al., "Object-level Voxel Modelling"): a sparse hashed
+/// set of voxels, each with the probability that it belongs to the object, updated keyframe by
+/// keyframe with the binary Bayes filter of the paper's eq. 1 (prior 0.5). As in OctoMap, the
+/// filter runs in log-odds with clamping, so an update is one addition:
+///     L(n | z_1:T) = clamp(L(n | z_1:T-1) + logit P(n | z_T)),  logit p = log(p / (1 - p)).
+/// A depth pixel inside the object's mask is a hit for the voxel it falls in; a voxel that
+/// projects into the frame outside the mask (and is not hidden), or in front of the measured
+/// depth inside the mask, is a miss.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "ellreloc/core/box.hpp"
+#include "ellreloc/core/camera.hpp"
+#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/observe/mask.hpp"
+
+namespace ellreloc {
+
+struct VoxelOptions {
+  double voxel_size = 0.02;       ///< metres
+  double hit_probability = 0.7;   ///< P(n | z) of a depth pixel inside the mask (OctoMap's default)
+  double miss_probability = 0.3;  ///< P(n | z) of a voxel seen outside the mask or in free space
+  double clamp_min = 0.12;        ///< probabilities are clamped to [clamp_min, clamp_max]
+  double clamp_max = 0.97;        ///< so that a voxel can change its mind
+  /// Voxels at or above this probability make up the object (boxes, ellipsoids, 3D matching).
+  double occupied_probability = 0.5;
+  /// A voxel this far (metres) in front of the measured depth lies in free space; one this
+  /// far behind it is hidden and gets no evidence.
+  double depth_tolerance = 0.04;
+  double min_depth = 0.1;  ///< depth readings outside [min_depth, max_depth] are ignored
+  double max_depth = 8.0;
+  /// Masks bleed onto what lies behind or in front of the object: a mask pixel whose depth is
+  /// further than max(depth_gate_min, depth_gate_sigmas x sigma) from the median depth of the
+  /// mask (sigma from the median absolute deviation) is not a hit. 0 sigmas: no gate.
+  double depth_gate_sigmas = 3.0;
+  double depth_gate_min = 0.1;
+  /// A 3x3 majority vote cleans the mask first: isolated pixels a segmentation network got
+  /// wrong (specks around the object, pinholes inside) would otherwise hit the background
+  /// voxels next to the object again and again.
+  bool mask_majority_filter = true;
+  int pixel_stride = 1;  ///< use every n-th mask pixel in x and y (speed vs density)
+  /// Memory bound: past this many voxels the least probable ones are dropped (about 40 bytes
+  /// per voxel with the hash table, so 200,000 voxels is about 8 MB per object).
+  size_t max_voxels = 200000;
+};
+
+/// What one keyframe did to an object.
+struct VoxelUpdate {
+  long hits = 0;    ///< voxels given a hit (each at most once per keyframe)
+  long misses = 0;  ///< voxels given a miss
+  long added = 0;   ///< voxels created
+};
+
+class VoxelObject {
+ public:
+  explicit VoxelObject(const VoxelOptions& options = {}) : options_(options) {}
+
+  /// Integrates one keyframe: world->camera `pose`, its depth image, and the object's mask in
+  /// that image (a full-image mask or a crop). Throws ellreloc::Error when the intrinsics,
+  /// pose, depth or mask are invalid or their sizes differ.
+  VoxelUpdate integrate(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth, const BinaryMask& mask);
+
+  /// Removes voxels whose probability is below `probability` (the paper's stage-by-stage filter).
+  size_t prune(double probability);
+
+  /// Number of voxels held (any probability).
+  size_t size() const { return voxels_.size(); }
+  /// Number of voxels at or above options().occupied_probability.
+  size_t occupiedCount() const;
+  /// Centres of the voxels at or above `min_probability` (default: the occupied ones), in
+  /// world coordinates.
+  std::vector<Eigen::Vector3d> occupiedCentres(std::optional<double> min_probability = std::nullopt) const;
+  /// The box of the occupied voxels projected into a camera (clipped to the image), or nullopt
+  /// when fewer than `min_voxels` of them land in front of the camera inside the image.
+  std::optional<Box> projectedBox(const Intrinsics& K, const Pose& pose, int min_voxels = 10) const;
+  /// Number of this object's occupied voxels that have an occupied voxel of `other` within
+  /// `radius` metres (centre to centre): n(this, other) of the paper's eq. 4. Both objects
+  /// must use the same voxel size.
+  long countNear(const VoxelObject& other, double radius) const;
+
+  /// The probability of the voxel containing a world point (0.5 when unknown).
+  double probabilityAt(const Eigen::Vector3d& x_w) const;
+  /// Approximate heap memory in bytes (voxels and hash table).
+  size_t memoryBytes() const;
+
+  const VoxelOptions& options() const { return options_; }
+  /// The world box of the occupied voxels (empty when there are none).
+  Eigen::AlignedBox3d bounds() const;
+
+ private:
+  struct Voxel {
+    float log_odds = 0.0f;
+    uint32_t stamp = 0;  ///< the keyframe that last touched it (one update per keyframe)
+  };
+  static uint64_t pack(int x, int y, int z);
+  static Eigen::Vector3i unpack(uint64_t key);
+  std::optional<uint64_t> keyOf(const Eigen::Vector3d& x_w) const;
+  Eigen::Vector3d centreOf(uint64_t key) const;
+  bool occupied(const Voxel& v) const;
+  void enforceBudget();
+  /// The [near, far] depths of the mask's hits (the depth gate).
+  std::pair<double, double> depthGate(const io::DepthImage& depth, const BinaryMask& mask, int stride) const;
+
+  struct KeyHash {
+    size_t operator()(uint64_t k) const {  // splitmix64 finaliser: packed keys are far from random
+      k ^= k >> 30;
+      k *= 0xbf58476d1ce4e5b9ULL;
+      k ^= k >> 27;
+      k *= 0x94d049bb133111ebULL;
+      return static_cast<size_t>(k ^ (k >> 31));
+    }
+  };
+  VoxelOptions options_;
+  std::unordered_map<uint64_t, Voxel, KeyHash> voxels_;
+  uint32_t frames_ = 0;
+};
+
+/// The mask after a 3x3 majority vote (5 of 9 pixels set), same crop.
+BinaryMask majorityFiltered(const BinaryMask& mask);
+
+/// A mask covering a box (the whole box is the object): for detectors without masks.
+BinaryMask maskFromBox(const Box& box, int image_width, int image_height);
+
+}  // namespace ellreloc

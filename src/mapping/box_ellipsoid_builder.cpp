@@ -1,0 +1,201 @@
+#include "ellreloc/mapping/box_ellipsoid_builder.hpp"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/ellipse.hpp"
+#include "ellreloc/core/projection.hpp"
+
+namespace ellreloc {
+namespace {
+
+/// W2 between the box-inscribed ellipse and the projection of the ellipsoid (centre c,
+/// semi-axes exp(s), rotation angle-axis w), divided by sqrt(a b) of the observed ellipse so
+/// that small and large boxes weigh alike. The 6-vector r has |r|^2 = W2^2 (distances.hpp).
+struct BoxW2Cost {
+  Eigen::Matrix<double, 3, 4> P;  // K [R | t]
+  Pose pose;
+  Ellipse observed;
+  double scale;
+
+  template <typename T>
+  bool operator()(const T* c, const T* s, const T* w, T* residual) const {
+    T R_data[9];
+    ceres::AngleAxisToRotationMatrix(w, ceres::ColumnMajorAdapter3x3(R_data));
+    const Eigen::Map<const Eigen::Matrix<T, 3, 3>> R(R_data);
+    const Eigen::Matrix<T, 3, 1> centre(c[0], c[1], c[2]);
+    Eigen::Matrix<T, 3, 1> axes2;
+    for (int k = 0; k < 3; ++k) axes2(k) = exp(T(2.0) * s[k]);
+    const Eigen::Matrix<T, 3, 3> M = R * axes2.asDiagonal() * R.transpose();
+    T near, far;
+    depthRange<T>(pose.rotation().cast<T>(), pose.translation().cast<T>(), centre, M, &near, &far);
+    if (!(near > T(0.0))) return false;  // the ellipsoid must stay in front of the camera
+    Eigen::Matrix<T, 4, 4> Q;
+    Q.template topLeftCorner<3, 3>() = M - centre * centre.transpose();
+    Q.template topRightCorner<3, 1>() = -centre;
+    Q.template bottomLeftCorner<1, 3>() = -centre.transpose();
+    Q(3, 3) = T(-1.0);
+    const Mat3<T> C = projectDualQuadric<T>(P.cast<T>(), Q);
+    Vec2<T> mean;
+    Mat2<T> cov;
+    gaussianFromDualConic<T>(C, &mean, &cov);
+    wasserstein2Residual<T>(observed.center().cast<T>(), observed.covariance().cast<T>(), mean, cov, residual);
+    for (int k = 0; k < 6; ++k) residual[k] /= T(scale);
+    return true;
+  }
+};
+
+bool touchesBorder(const Box& b, const Intrinsics& K, double border) {
+  return b.x1 <= -0.5 + border || b.y1 <= -0.5 + border || b.x2 >= K.width - 0.5 - border ||
+         b.y2 >= K.height - 0.5 - border;
+}
+
+Box boundingBox(const Ellipse& e) {
+  const Eigen::Matrix2d S = e.covariance();
+  const double hx = std::sqrt(S(0, 0)), hy = std::sqrt(S(1, 1));
+  return Box(e.center().x() - hx, e.center().y() - hy, e.center().x() + hx, e.center().y() + hy);
+}
+
+double medianOf(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+const char* toString(BoxEllipsoidStatus status) {
+  switch (status) {
+    case BoxEllipsoidStatus::Ok:
+      return "ok";
+    case BoxEllipsoidStatus::TooFewViews:
+      return "too few views";
+    case BoxEllipsoidStatus::NoBaseline:
+      return "no baseline";
+    case BoxEllipsoidStatus::BehindCamera:
+      return "behind camera";
+    case BoxEllipsoidStatus::PoorFit:
+      return "poor fit";
+    case BoxEllipsoidStatus::InvalidInput:
+      return "invalid input";
+  }
+  return "unknown";
+}
+
+std::optional<Eigen::Vector3d> triangulateBoxCentres(const Intrinsics& K, const std::vector<BoxView>& views) {
+  if (!K.isValid() || views.size() < 2) return std::nullopt;
+  // Minimise sum_i |(I - d_i d_i^T)(x - o_i)|^2 over x: the point nearest to all rays.
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const BoxView& v : views) {
+    if (!v.pose.isValid() || !v.box.isValid()) return std::nullopt;
+    const Eigen::Vector2d uv(0.5 * (v.box.x1 + v.box.x2), 0.5 * (v.box.y1 + v.box.y2));
+    const Eigen::Vector3d d = v.pose.rotation().transpose() * K.bearing(uv);
+    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+    A += P;
+    b += P * v.pose.center();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(A);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues()(0) > 1e-6 * eig.eigenvalues()(2))) return std::nullopt;
+  const Eigen::Vector3d x = A.ldlt().solve(b);
+  if (!x.allFinite()) return std::nullopt;
+  return x;
+}
+
+BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vector<BoxView>& all_views,
+                                           const BoxEllipsoidOptions& options) {
+  BoxEllipsoidResult out;
+  if (!K.isValid()) {
+    out.reason = "invalid intrinsics";
+    return out;
+  }
+  std::vector<BoxView> valid, inside;
+  for (const BoxView& v : all_views) {
+    if (!v.pose.isValid() || !v.box.isValid() || !(v.box.area() > 1.0)) continue;
+    valid.push_back(v);
+    if (!touchesBorder(v.box, K, options.border_px)) inside.push_back(v);
+  }
+  const std::vector<BoxView>& views = inside.size() >= options.min_views ? inside : valid;
+  out.views_used = static_cast<int>(views.size());
+  if (views.size() < std::max<size_t>(options.min_views, 2)) {
+    out.status = BoxEllipsoidStatus::TooFewViews;
+    out.reason = std::to_string(views.size()) + " valid views";
+    return out;
+  }
+  // Baseline: the widest angle between two viewing rays through the box centres.
+  std::vector<Eigen::Vector3d> rays;
+  for (const BoxView& v : views)
+    rays.push_back(v.pose.rotation().transpose() *
+                   K.bearing(Eigen::Vector2d(0.5 * (v.box.x1 + v.box.x2), 0.5 * (v.box.y1 + v.box.y2))));
+  double min_cos = 1.0;
+  for (size_t i = 0; i < rays.size(); ++i)
+    for (size_t j = i + 1; j < rays.size(); ++j) min_cos = std::min(min_cos, rays[i].dot(rays[j]));
+  out.baseline_deg = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 180.0 / M_PI;
+  const auto centre = triangulateBoxCentres(K, views);
+  if (out.baseline_deg < options.min_baseline_deg || !centre) {
+    out.status = BoxEllipsoidStatus::NoBaseline;
+    out.reason = "rays span " + std::to_string(out.baseline_deg) + " deg";
+    return out;
+  }
+  // Initial semi-axes: a sphere whose size matches the boxes at the triangulated depth.
+  std::vector<double> radii;
+  for (const BoxView& v : views) {
+    const double z = v.pose.transform(*centre).z();
+    if (!(z > 0.0)) {
+      out.status = BoxEllipsoidStatus::BehindCamera;
+      out.reason = "triangulated centre behind a camera";
+      return out;
+    }
+    radii.push_back(0.25 * (v.box.width() / K.fx + v.box.height() / K.fy) * z);
+  }
+  double c[3] = {centre->x(), centre->y(), centre->z()};
+  const double log_r = std::log(std::max(1e-3, medianOf(radii)));
+  double s[3] = {log_r, log_r, log_r};
+  double w[3] = {0.0, 0.0, 0.0};
+
+  ceres::Problem problem;
+  for (const BoxView& v : views) {
+    const auto e = Ellipse::inscribedInBox(v.box);
+    if (!e) continue;
+    auto* cost = new BoxW2Cost{projectionMatrix(K, v.pose), v.pose, *e, std::sqrt(e->axes().prod())};
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BoxW2Cost, 6, 3, 3, 3>(cost), new ceres::HuberLoss(0.5), c,
+                             s, w);
+  }
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+
+  double R_data[9];
+  ceres::AngleAxisToRotationMatrix(w, ceres::ColumnMajorAdapter3x3(R_data));
+  const Eigen::Matrix3d R = nearestRotation(Eigen::Map<const Eigen::Matrix3d>(R_data));
+  out.ellipsoid =
+      Ellipsoid(Eigen::Vector3d(c[0], c[1], c[2]), Eigen::Vector3d(std::exp(s[0]), std::exp(s[1]), std::exp(s[2])), R);
+  if (!out.ellipsoid.isValid()) {
+    out.status = BoxEllipsoidStatus::InvalidInput;
+    out.reason = "refinement diverged";
+    return out;
+  }
+  std::vector<double> ious;
+  for (const BoxView& v : views) {
+    const Projection p = project(out.ellipsoid, K, v.pose);
+    ious.push_back(p ? boxIoU(boundingBox(p.ellipse), v.box) : 0.0);
+  }
+  out.median_iou = medianOf(ious);
+  if (out.median_iou < options.min_median_iou) {
+    out.status = BoxEllipsoidStatus::PoorFit;
+    out.reason = "median reprojection IoU " + std::to_string(out.median_iou);
+    return out;
+  }
+  out.status = BoxEllipsoidStatus::Ok;
+  return out;
+}
+
+}  // namespace ellreloc

@@ -1,0 +1,285 @@
+#include "ellreloc/mapping/mapper.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/error.hpp"
+
+namespace ellreloc {
+namespace {
+
+std::string keyframeText(int index) { return "keyframe " + std::to_string(index); }
+
+bool boxFinite(const Box& b) {
+  return std::isfinite(b.x1) && std::isfinite(b.y1) && std::isfinite(b.x2) && std::isfinite(b.y2);
+}
+
+/// The axis-aligned box of an ellipse (shape matrix diagonal = squared half-widths).
+Box ellipseBox(const Ellipse& e) {
+  const Eigen::Matrix2d S = e.covariance();
+  const double hx = std::sqrt(S(0, 0)), hy = std::sqrt(S(1, 1));
+  return Box(e.center().x() - hx, e.center().y() - hy, e.center().x() + hx, e.center().y() + hy);
+}
+
+}  // namespace
+
+const char* toString(MappingMode mode) { return mode == MappingMode::Voxel ? "voxel" : "boxes"; }
+
+bool parseMappingMode(const std::string& name, MappingMode* mode) {
+  if (name == "voxel") return *mode = MappingMode::Voxel, true;
+  if (name == "boxes") return *mode = MappingMode::Boxes, true;
+  return false;
+}
+
+int Mapper::Track::label() const {
+  int best = -1;
+  double best_weight = -1.0;
+  for (const auto& [category, weight] : labels)
+    if (weight > best_weight) best = category, best_weight = weight;
+  return best;
+}
+
+Mapper::Mapper(const Intrinsics& K, const MapperOptions& options) : K_(K), options_(options) {
+  if (!K.isValid()) throw Error("mapper: invalid camera intrinsics");
+  if (!(options.voxels.voxel_size > 0.0) || options.min_observations < 1 || options.track_window < 1 ||
+      options.candidate_lifetime < 1)
+    throw Error("mapper: voxel size must be positive and min_observations, track_window, candidate_lifetime >= 1");
+}
+
+void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detections,
+                           const io::DepthImage* depth) const {
+  const std::string where = keyframeText(keyframes_);
+  if (!pose.isValid()) throw Error(where + ": pose is not a finite rigid transform");
+  if (options_.mode == MappingMode::Voxel) {
+    if (depth == nullptr) throw Error(where + ": voxel mapping needs a depth image");
+    if (depth->width != K_.width || depth->height != K_.height ||
+        depth->metres.size() != static_cast<size_t>(K_.width) * static_cast<size_t>(K_.height))
+      throw Error(where + ": depth image is " + std::to_string(depth->width) + "x" + std::to_string(depth->height) +
+                  ", camera is " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
+    const bool any = std::any_of(depth->metres.begin(), depth->metres.end(), [](float d) { return d > 0.0f; });
+    if (!any) throw Error(where + ": depth image has no valid reading");
+  }
+  for (size_t j = 0; j < detections.size(); ++j) {
+    const Detection& d = detections[j];
+    const std::string det = where + ": detection " + std::to_string(j);
+    if (!boxFinite(d.bbox) || !std::isfinite(d.score)) throw Error(det + ": box or score is not finite");
+    if (d.mask && (d.mask->width != K_.width || d.mask->height != K_.height))
+      throw Error(det + ": mask is " + std::to_string(d.mask->width) + "x" + std::to_string(d.mask->height) +
+                  ", camera is " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
+    if (d.mask && !d.mask->isConsistent()) throw Error(det + ": mask runs do not add up to its size");
+  }
+}
+
+KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection>& detections,
+                                   const io::DepthImage* depth) {
+  std::unique_lock lock(mutex_);
+  checkKeyframe(pose, detections, depth);
+  KeyframeReport report;
+  if (options_.mode == MappingMode::Voxel)
+    addVoxelKeyframe(pose, detections, *depth, &report);
+  else
+    addBoxKeyframe(pose, detections, &report);
+  // Forget candidates that were not seen again (false detections, passing clutter).
+  tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
+                               [&](const Track& t) {
+                                 return !t.confirmed && keyframes_ - t.last_seen > options_.candidate_lifetime;
+                               }),
+                tracks_.end());
+  ++keyframes_;
+  return report;
+}
+
+void Mapper::observed(Track& track, const Detection& detection) {
+  track.labels[detection.category_id] += std::max(detection.score, 1e-3);
+  ++track.observations;
+  track.last_seen = keyframes_;
+  if (track.observations >= options_.min_observations) track.confirmed = true;
+  if (track.confirmed && options_.mode == MappingMode::Voxel) track.voxels.prune(options_.prune_probability);
+  if (track.confirmed) rebuild(track);
+}
+
+void Mapper::rebuild(Track& track) const {
+  MappedObject m;
+  m.object.id = track.id;
+  m.object.category = track.label();
+  m.object.category_counts = track.labels;
+  m.observations = track.observations;
+  if (options_.mode == MappingMode::Voxel) {
+    const auto built =
+        buildEllipsoid(track.voxels.occupiedCentres(options_.ellipsoid_min_probability), options_.ellipsoid);
+    if (!built) return;  // keeps the previous ellipsoid, if any
+    m.object.ellipsoid = built->ellipsoid;
+    m.cuboid = built->cuboid;
+    m.voxels = track.voxels.size();
+    m.memory_bytes = track.voxels.memoryBytes();
+  } else {
+    const BoxEllipsoidResult r = buildEllipsoidFromBoxes(K_, track.views, options_.boxes);
+    if (!r.ok()) {
+      track.built.reset();  // boxes that no longer agree: out of the map until they do
+      return;
+    }
+    m.object.ellipsoid = r.ellipsoid;
+  }
+  track.built = m;
+}
+
+void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const io::DepthImage& depth,
+                              KeyframeReport* report) {
+  // The keyframe's usable detections with their masks (a box stands in for a missing mask).
+  std::vector<size_t> used;
+  std::vector<BinaryMask> masks;
+  for (size_t j = 0; j < detections.size(); ++j) {
+    const Detection& d = detections[j];
+    std::optional<BinaryMask> mask =
+        d.mask ? decodeMaskCrop(*d.mask) : std::optional<BinaryMask>(maskFromBox(d.bbox, K_.width, K_.height));
+    if (d.score < options_.min_score || !mask || mask->count() < options_.min_mask_pixels) {
+      ++report->ignored;
+      continue;
+    }
+    used.push_back(j);
+    masks.push_back(std::move(*mask));
+  }
+
+  // 2D tracking against the objects seen in the last keyframes, by their projected voxels.
+  std::vector<size_t> recent;
+  std::vector<LabelledBox> object_boxes;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (keyframes_ - tracks_[i].last_seen > options_.track_window) continue;
+    const auto box = tracks_[i].voxels.projectedBox(K_, pose);
+    if (!box) continue;
+    recent.push_back(i);
+    object_boxes.push_back({*box, tracks_[i].label()});
+  }
+  std::vector<LabelledBox> detection_boxes;
+  for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id});
+  const std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking);
+
+  for (size_t k = 0; k < used.size(); ++k) {
+    const Detection& d = detections[used[k]];
+    ++report->used;
+    if (tracked[k] >= 0) {
+      Track& t = tracks_[recent[static_cast<size_t>(tracked[k])]];
+      t.voxels.integrate(K_, pose, depth, masks[k]);
+      observed(t, d);
+      ++report->tracked_2d;
+      continue;
+    }
+    // 3D matching: the detection's own voxels against every object of its label (eq. 4).
+    VoxelObject fresh(options_.voxels);
+    fresh.integrate(K_, pose, depth, masks[k]);
+    if (fresh.occupiedCount() == 0) {
+      --report->used, ++report->ignored;  // no depth inside the mask
+      continue;
+    }
+    Track* match = nullptr;
+    for (Track& t : tracks_) {
+      if (t.last_seen == keyframes_ || t.label() != d.category_id) continue;
+      if (voxelObjectsMatch(fresh, t.voxels, options_.tracking)) {
+        match = &t;
+        break;
+      }
+    }
+    if (match != nullptr) {
+      match->voxels.integrate(K_, pose, depth, masks[k]);
+      observed(*match, d);
+      ++report->matched_3d;
+      continue;
+    }
+    Track t;
+    t.id = next_id_++;
+    t.voxels = std::move(fresh);
+    tracks_.push_back(std::move(t));
+    observed(tracks_.back(), d);
+    ++report->new_objects;
+  }
+}
+
+void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report) {
+  std::vector<size_t> used;
+  for (size_t j = 0; j < detections.size(); ++j) {
+    if (detections[j].score < options_.min_score || !(detections[j].bbox.area() > 1.0)) {
+      ++report->ignored;
+      continue;
+    }
+    used.push_back(j);
+  }
+  // A track's expected box: its last box when seen in the last keyframes, else the projection
+  // of its ellipsoid (or of a sphere at its triangulated centre) into this keyframe.
+  std::vector<size_t> candidates;
+  std::vector<LabelledBox> object_boxes;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& t = tracks_[i];
+    std::optional<Box> expected;
+    if (keyframes_ - t.last_seen <= options_.track_window) {
+      expected = t.views.back().box;
+    } else {
+      std::optional<Ellipsoid> e;
+      if (t.built) {
+        e = t.built->object.ellipsoid;
+      } else if (const auto c = triangulateBoxCentres(K_, t.views)) {
+        const BoxView& last = t.views.back();
+        const double z = last.pose.transform(*c).z();
+        const double r = 0.25 * (last.box.width() / K_.fx + last.box.height() / K_.fy) * z;
+        if (r > 0.0) e = Ellipsoid(*c, Eigen::Vector3d::Constant(r), Eigen::Matrix3d::Identity());
+      }
+      if (e) {
+        const Projection p = project(*e, K_, pose);
+        if (p) expected = ellipseBox(p.ellipse);
+      }
+    }
+    if (!expected) continue;
+    candidates.push_back(i);
+    object_boxes.push_back({*expected, t.label()});
+  }
+  std::vector<LabelledBox> detection_boxes;
+  for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id});
+  const std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking);
+  for (size_t k = 0; k < used.size(); ++k) {
+    const Detection& d = detections[used[k]];
+    ++report->used;
+    Track* t = nullptr;
+    if (tracked[k] >= 0) {
+      t = &tracks_[candidates[static_cast<size_t>(tracked[k])]];
+      ++report->tracked_2d;
+    } else {
+      tracks_.emplace_back();
+      t = &tracks_.back();
+      t->id = next_id_++;
+      ++report->new_objects;
+    }
+    t->views.push_back({pose, d.bbox});
+    observed(*t, d);
+  }
+}
+
+ObjectMap Mapper::map() const {
+  std::shared_lock lock(mutex_);
+  ObjectMap out;
+  for (const Track& t : tracks_)
+    if (t.confirmed && t.built) out.objects.push_back(t.built->object);
+  return out;
+}
+
+std::vector<MappedObject> Mapper::objects() const {
+  std::shared_lock lock(mutex_);
+  std::vector<MappedObject> out;
+  for (const Track& t : tracks_)
+    if (t.confirmed && t.built) out.push_back(*t.built);
+  return out;
+}
+
+MapperStats Mapper::stats() const {
+  std::shared_lock lock(mutex_);
+  MapperStats s;
+  s.keyframes = keyframes_;
+  for (const Track& t : tracks_) {
+    (t.confirmed && t.built ? s.objects : s.candidates) += 1;
+    s.voxels += t.voxels.size();
+    s.memory_bytes += t.voxels.memoryBytes();
+  }
+  return s;
+}
+
+}  // namespace ellreloc

@@ -1,0 +1,304 @@
+#include "ellreloc/mapping/voxel_object.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "ellreloc/error.hpp"
+
+namespace ellreloc {
+namespace {
+
+constexpr int kKeyBits = 21;
+constexpr int kKeyOffset = 1 << (kKeyBits - 1);  // keys span [-2^20, 2^20) voxels per axis
+constexpr uint64_t kKeyMask = (uint64_t{1} << kKeyBits) - 1;
+
+double logit(double p) { return std::log(p / (1.0 - p)); }
+
+bool inMask(const BinaryMask& mask, int x, int y) {
+  const int lx = x - mask.x0, ly = y - mask.y0;
+  return mask.inside(lx, ly) && mask.at(lx, ly) != 0;
+}
+
+void checkInputs(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth, const BinaryMask& mask) {
+  if (!K.isValid()) throw Error("voxel integration: invalid camera intrinsics");
+  if (!pose.isValid()) throw Error("voxel integration: keyframe pose is not a finite rigid transform");
+  if (depth.width != K.width || depth.height != K.height ||
+      depth.metres.size() != static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height))
+    throw Error("voxel integration: depth image is " + std::to_string(depth.width) + "x" +
+                std::to_string(depth.height) + ", camera is " + std::to_string(K.width) + "x" +
+                std::to_string(K.height));
+  if (mask.image_width != depth.width || mask.image_height != depth.height ||
+      mask.data.size() != static_cast<size_t>(mask.width) * static_cast<size_t>(mask.height))
+    throw Error("voxel integration: mask is for a " + std::to_string(mask.image_width) + "x" +
+                std::to_string(mask.image_height) + " image, depth is " + std::to_string(depth.width) + "x" +
+                std::to_string(depth.height));
+}
+
+}  // namespace
+
+BinaryMask majorityFiltered(const BinaryMask& mask) {
+  BinaryMask out = mask;
+  for (int y = 0; y < mask.height; ++y)
+    for (int x = 0; x < mask.width; ++x) {
+      int votes = 0;  // pixels outside the crop count as 0, like the rest of the image
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) votes += mask.inside(x + dx, y + dy) && mask.at(x + dx, y + dy) != 0;
+      out.at(x, y) = votes >= 5 ? 1 : 0;
+    }
+  return out;
+}
+
+std::pair<double, double> VoxelObject::depthGate(const io::DepthImage& depth, const BinaryMask& mask,
+                                                 int stride) const {
+  std::pair<double, double> range(options_.min_depth, options_.max_depth);
+  if (!(options_.depth_gate_sigmas > 0.0)) return range;
+  std::vector<double> d;
+  for (int ly = 0; ly < mask.height; ly += stride)
+    for (int lx = 0; lx < mask.width; lx += stride) {
+      if (mask.at(lx, ly) == 0) continue;
+      const double v = depth.at(lx + mask.x0, ly + mask.y0);
+      if (v >= options_.min_depth && v <= options_.max_depth) d.push_back(v);
+    }
+  if (d.empty()) return range;
+  const auto mid = d.begin() + static_cast<long>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  const double median = *mid;
+  for (double& v : d) v = std::abs(v - median);
+  std::nth_element(d.begin(), mid, d.end());
+  const double sigma = 1.4826 * *mid;  // the MAD of a Gaussian is 0.6745 sigma
+  const double half = std::max(options_.depth_gate_min, options_.depth_gate_sigmas * sigma);
+  return {std::max(range.first, median - half), std::min(range.second, median + half)};
+}
+
+uint64_t VoxelObject::pack(int x, int y, int z) {
+  return (static_cast<uint64_t>(x + kKeyOffset) << (2 * kKeyBits)) |
+         (static_cast<uint64_t>(y + kKeyOffset) << kKeyBits) | static_cast<uint64_t>(z + kKeyOffset);
+}
+
+Eigen::Vector3i VoxelObject::unpack(uint64_t key) {
+  return Eigen::Vector3i(static_cast<int>((key >> (2 * kKeyBits)) & kKeyMask) - kKeyOffset,
+                         static_cast<int>((key >> kKeyBits) & kKeyMask) - kKeyOffset,
+                         static_cast<int>(key & kKeyMask) - kKeyOffset);
+}
+
+std::optional<uint64_t> VoxelObject::keyOf(const Eigen::Vector3d& x_w) const {
+  const Eigen::Vector3d g = (x_w / options_.voxel_size).array().floor();
+  if (!g.allFinite() || g.cwiseAbs().maxCoeff() >= kKeyOffset - 1) return std::nullopt;
+  return pack(static_cast<int>(g(0)), static_cast<int>(g(1)), static_cast<int>(g(2)));
+}
+
+Eigen::Vector3d VoxelObject::centreOf(uint64_t key) const {
+  return (unpack(key).cast<double>().array() + 0.5).matrix() * options_.voxel_size;
+}
+
+bool VoxelObject::occupied(const Voxel& v) const {
+  return v.log_odds >= static_cast<float>(logit(options_.occupied_probability));
+}
+
+VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth,
+                                   const BinaryMask& raw_mask) {
+  checkInputs(K, pose, depth, raw_mask);
+  const BinaryMask filtered = options_.mask_majority_filter ? majorityFiltered(raw_mask) : BinaryMask();
+  const BinaryMask& mask = options_.mask_majority_filter ? filtered : raw_mask;
+  if (!(options_.voxel_size > 0.0) || !(options_.hit_probability > 0.5 && options_.hit_probability < 1.0) ||
+      !(options_.miss_probability > 0.0 && options_.miss_probability < 0.5) ||
+      !(options_.clamp_min > 0.0 && options_.clamp_min < options_.clamp_max && options_.clamp_max < 1.0))
+    throw Error(
+        "voxel integration: voxel size must be positive and 0 < miss < 0.5 < hit < 1, 0 < clamp_min < clamp_max < 1");
+  ++frames_;
+  VoxelUpdate update;
+  const float l_hit = static_cast<float>(logit(options_.hit_probability));
+  const float l_miss = static_cast<float>(logit(options_.miss_probability));
+  const float l_min = static_cast<float>(logit(options_.clamp_min));
+  const float l_max = static_cast<float>(logit(options_.clamp_max));
+  const Eigen::Matrix3d R_wc = pose.rotation().transpose();
+  const Eigen::Vector3d c_w = pose.center();
+  const int stride = std::max(1, options_.pixel_stride);
+
+  // Hits: every depth pixel inside the mask (within the depth gate), back-projected; a voxel
+  // is hit once per keyframe.
+  const auto [gate_lo, gate_hi] = depthGate(depth, mask, stride);
+  for (int ly = 0; ly < mask.height; ly += stride) {
+    const int y = ly + mask.y0;
+    for (int lx = 0; lx < mask.width; lx += stride) {
+      if (mask.at(lx, ly) == 0) continue;
+      const int x = lx + mask.x0;
+      const double d = depth.at(x, y);
+      if (!(d >= gate_lo && d <= gate_hi)) continue;
+      const Eigen::Vector3d x_c((x - K.cx) / K.fx * d, (y - K.cy) / K.fy * d, d);
+      const auto key = keyOf(R_wc * x_c + c_w);
+      if (!key) continue;
+      auto [it, inserted] = voxels_.try_emplace(*key);
+      Voxel& v = it->second;
+      if (inserted) ++update.added;
+      if (v.stamp == frames_) continue;
+      v.stamp = frames_;
+      v.log_odds = std::min(l_max, v.log_odds + l_hit);
+      ++update.hits;
+    }
+  }
+
+  // Misses: voxels not hit this keyframe that the camera should have seen as the object.
+  for (auto& [key, v] : voxels_) {
+    if (v.stamp == frames_) continue;
+    const Eigen::Vector3d x_c = pose.transform(centreOf(key));
+    if (x_c.z() < options_.min_depth) continue;
+    const int u = static_cast<int>(std::lround(K.fx * x_c.x() / x_c.z() + K.cx));
+    const int w = static_cast<int>(std::lround(K.fy * x_c.y() / x_c.z() + K.cy));
+    if (u < 0 || w < 0 || u >= K.width || w >= K.height) continue;
+    const double d = depth.at(u, w);
+    if (!(d >= options_.min_depth && d <= options_.max_depth)) continue;  // no reading: no evidence
+    const bool hidden = x_c.z() > d + options_.depth_tolerance;
+    const bool in_free_space = x_c.z() < d - options_.depth_tolerance;
+    const bool seen_outside_mask = !inMask(mask, u, w) && !hidden;
+    if (!seen_outside_mask && !in_free_space) continue;
+    v.stamp = frames_;
+    v.log_odds = std::max(l_min, v.log_odds + l_miss);
+    ++update.misses;
+  }
+  enforceBudget();
+  return update;
+}
+
+void VoxelObject::enforceBudget() {
+  if (options_.max_voxels == 0 || voxels_.size() <= options_.max_voxels) return;
+  std::vector<float> odds;
+  odds.reserve(voxels_.size());
+  for (const auto& [key, v] : voxels_) odds.push_back(v.log_odds);
+  const size_t drop = voxels_.size() - options_.max_voxels;
+  std::nth_element(odds.begin(), odds.begin() + static_cast<long>(drop), odds.end());
+  const float cut = odds[drop];
+  // Everything below the cut goes (at most `drop` voxels), then voxels at the cut until done.
+  size_t dropped = 0;
+  for (const bool at_cut : {false, true}) {
+    for (auto it = voxels_.begin(); it != voxels_.end() && dropped < drop;) {
+      const float l = it->second.log_odds;
+      if (at_cut ? l == cut : l < cut) {
+        it = voxels_.erase(it);
+        ++dropped;
+      } else {
+        ++it;
+      }
+    }
+  }
+}
+
+size_t VoxelObject::prune(double probability) {
+  if (!(probability > 0.0 && probability < 1.0)) return 0;
+  const float cut = static_cast<float>(logit(probability));
+  size_t removed = 0;
+  for (auto it = voxels_.begin(); it != voxels_.end();) {
+    if (it->second.log_odds < cut) {
+      it = voxels_.erase(it);
+      ++removed;
+    } else {
+      ++it;
+    }
+  }
+  return removed;
+}
+
+size_t VoxelObject::occupiedCount() const {
+  size_t n = 0;
+  for (const auto& [key, v] : voxels_) n += occupied(v);
+  return n;
+}
+
+std::vector<Eigen::Vector3d> VoxelObject::occupiedCentres(std::optional<double> min_probability) const {
+  const double p = std::clamp(min_probability.value_or(options_.occupied_probability), 1e-9, 1.0 - 1e-9);
+  const float cut = static_cast<float>(logit(p));
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(voxels_.size());
+  for (const auto& [key, v] : voxels_)
+    if (v.log_odds >= cut) out.push_back(centreOf(key));
+  return out;
+}
+
+Eigen::AlignedBox3d VoxelObject::bounds() const {
+  Eigen::AlignedBox3d box;
+  for (const auto& [key, v] : voxels_)
+    if (occupied(v)) box.extend(centreOf(key));
+  return box;
+}
+
+std::optional<Box> VoxelObject::projectedBox(const Intrinsics& K, const Pose& pose, int min_voxels) const {
+  if (!K.isValid() || !pose.isValid()) return std::nullopt;
+  double x1 = 1e300, y1 = 1e300, x2 = -1e300, y2 = -1e300;
+  int n = 0;
+  for (const auto& [key, v] : voxels_) {
+    if (!occupied(v)) continue;
+    const Eigen::Vector3d x_c = pose.transform(centreOf(key));
+    if (x_c.z() < 1e-3) continue;
+    const double u = K.fx * x_c.x() / x_c.z() + K.cx, w = K.fy * x_c.y() / x_c.z() + K.cy;
+    if (u < -0.5 || w < -0.5 || u > K.width - 0.5 || w > K.height - 0.5) continue;
+    x1 = std::min(x1, u), x2 = std::max(x2, u), y1 = std::min(y1, w), y2 = std::max(y2, w);
+    ++n;
+  }
+  if (n < std::max(1, min_voxels)) return std::nullopt;
+  return Box(x1, y1, x2, y2);
+}
+
+long VoxelObject::countNear(const VoxelObject& other, double radius) const {
+  const double size = options_.voxel_size;
+  const int reach = static_cast<int>(std::ceil(radius / size));
+  // Neighbour offsets within the radius, nearest first, so that most searches stop early.
+  std::vector<Eigen::Vector3i> offsets;
+  for (int dx = -reach; dx <= reach; ++dx)
+    for (int dy = -reach; dy <= reach; ++dy)
+      for (int dz = -reach; dz <= reach; ++dz)
+        if ((dx * dx + dy * dy + dz * dz) * size * size <= radius * radius + 1e-12) offsets.emplace_back(dx, dy, dz);
+  std::sort(offsets.begin(), offsets.end(),
+            [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) { return a.squaredNorm() < b.squaredNorm(); });
+  Eigen::AlignedBox3d reach_box = other.bounds();
+  if (reach_box.isEmpty()) return 0;
+  reach_box.min().array() -= radius + size;
+  reach_box.max().array() += radius + size;
+  long n = 0;
+  for (const auto& [key, v] : voxels_) {
+    if (!occupied(v) || !reach_box.contains(centreOf(key))) continue;
+    const Eigen::Vector3i g = unpack(key);
+    for (const Eigen::Vector3i& o : offsets) {
+      const auto it = other.voxels_.find(pack(g(0) + o(0), g(1) + o(1), g(2) + o(2)));
+      if (it != other.voxels_.end() && other.occupied(it->second)) {
+        ++n;
+        break;
+      }
+    }
+  }
+  return n;
+}
+
+double VoxelObject::probabilityAt(const Eigen::Vector3d& x_w) const {
+  const auto key = keyOf(x_w);
+  if (!key) return 0.5;
+  const auto it = voxels_.find(*key);
+  return it == voxels_.end() ? 0.5 : 1.0 / (1.0 + std::exp(-static_cast<double>(it->second.log_odds)));
+}
+
+size_t VoxelObject::memoryBytes() const {
+  // One node per voxel (key, value, next pointer, cached hash) plus the bucket array.
+  const size_t node = sizeof(uint64_t) + sizeof(Voxel) + 2 * sizeof(void*);
+  return voxels_.size() * node + voxels_.bucket_count() * sizeof(void*);
+}
+
+BinaryMask maskFromBox(const Box& box, int image_width, int image_height) {
+  BinaryMask m;
+  m.image_width = image_width;
+  m.image_height = image_height;
+  if (!box.isValid()) return m;  // empty: zero-sized crop
+  // Pixel (x, y) covers [x - 0.5, x + 0.5]: it belongs to the box when its centre is inside.
+  const int x1 = static_cast<int>(std::max(0.0, std::ceil(box.x1)));
+  const int y1 = static_cast<int>(std::max(0.0, std::ceil(box.y1)));
+  const int x2 = static_cast<int>(std::min(image_width - 1.0, std::floor(box.x2)));
+  const int y2 = static_cast<int>(std::min(image_height - 1.0, std::floor(box.y2)));
+  if (x2 < x1 || y2 < y1) return m;
+  m.x0 = x1;
+  m.y0 = y1;
+  m.width = x2 - x1 + 1;
+  m.height = y2 - y1 + 1;
+  m.data.assign(static_cast<size_t>(m.width) * static_cast<size_t>(m.height), 1);
+  return m;
+}
+
+}  // namespace ellreloc
