@@ -88,38 +88,54 @@ inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vec
     return std::nullopt;
   const Eigen::Matrix3d B = groundBasis(options.up);
 
-  // PCA of the ground-plane projections: the main axis gives the yaw.
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : points) mean += (B.leftCols<2>().transpose() * p);
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-  for (const auto& p : points) {
-    const Eigen::Vector2d d = B.leftCols<2>().transpose() * p - mean;
-    cov += d * d.transpose();
+  // PCA of the ground-plane projections: the main axis gives the yaw. PCA weighs far points
+  // heavily, so it runs twice: on all points, then on those inside the percentile cuboid of
+  // the first pass (a trimmed PCA).
+  std::vector<Eigen::Vector2d> ground(points.size());
+  std::vector<double> heights(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    ground[i] = B.leftCols<2>().transpose() * points[i];
+    heights[i] = B.col(2).dot(points[i]);
   }
-  if (!cov.allFinite()) return std::nullopt;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-  const Eigen::Vector2d main = eig.eigenvectors().col(1);  // largest eigenvalue
+  std::vector<char> inlier(points.size(), 1);
+  Eigen::Vector2d main, lo, hi;
+  for (int pass = 0; pass < 2; ++pass) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double n = 0.0;
+    for (size_t i = 0; i < ground.size(); ++i)
+      if (inlier[i]) mean += ground[i], n += 1.0;
+    if (n < 4.0) return std::nullopt;
+    mean /= n;
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (size_t i = 0; i < ground.size(); ++i)
+      if (inlier[i]) cov += (ground[i] - mean) * (ground[i] - mean).transpose();
+    if (!cov.allFinite()) return std::nullopt;
+    main = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvectors().col(1);  // largest eigenvalue
+    const Eigen::Vector2d side(-main.y(), main.x());
+    std::vector<double> along(ground.size()), across(ground.size());
+    for (size_t i = 0; i < ground.size(); ++i) along[i] = main.dot(ground[i]), across[i] = side.dot(ground[i]);
+    lo = Eigen::Vector2d(detail::quantile(along, options.low_percentile),
+                         detail::quantile(across, options.low_percentile));
+    hi = Eigen::Vector2d(detail::quantile(along, options.high_percentile),
+                         detail::quantile(across, options.high_percentile));
+    for (size_t i = 0; i < ground.size(); ++i)
+      inlier[i] = along[i] >= lo.x() && along[i] <= hi.x() && across[i] >= lo.y() && across[i] <= hi.y();
+  }
   const double yaw = std::atan2(main.y(), main.x());
 
-  Eigen::Matrix3d R;  // cuboid -> world: main ground axis, the other ground axis, up
-  R.col(0) = B.leftCols<2>() * main;
-  R.col(2) = B.col(2);
-  R.col(1) = R.col(2).cross(R.col(0));
-
-  Cuboid cuboid;
-  cuboid.rotation = R;
-  Eigen::Vector3d local_center;
-  for (int axis = 0; axis < 3; ++axis) {
-    std::vector<double> coords(points.size());
-    for (size_t i = 0; i < points.size(); ++i) coords[i] = R.col(axis).dot(points[i]);
-    const double lo = detail::quantile(coords, options.low_percentile);
-    const double hi = detail::quantile(coords, options.high_percentile);
-    local_center(axis) = 0.5 * (lo + hi);
-    cuboid.half(axis) = 0.5 * (hi - lo) + options.extent_padding;
-  }
+  Cuboid cuboid;  // axes: the main ground axis, the other ground axis, up
+  cuboid.rotation.col(0) = B.leftCols<2>() * main;
+  cuboid.rotation.col(2) = B.col(2);
+  cuboid.rotation.col(1) = cuboid.rotation.col(2).cross(cuboid.rotation.col(0));
+  const double h_lo = detail::quantile(heights, options.low_percentile);
+  const double h_hi = detail::quantile(heights, options.high_percentile);
+  const Eigen::Vector3d local_lo(lo.x(), lo.y(), h_lo), local_hi(hi.x(), hi.y(), h_hi);
+  // The second pass's percentiles are of all points in its final frame: outliers stay out.
+  cuboid.half = 0.5 * (local_hi - local_lo) + Eigen::Vector3d::Constant(options.extent_padding);
+  const Eigen::Vector3d local_center = 0.5 * (local_lo + local_hi);
+  // local coordinates are (main, side, up) in the basis B; side = up x main matches col(1).
   if (!(cuboid.half.minCoeff() > 0.0) || !cuboid.half.allFinite()) return std::nullopt;
-  cuboid.center = R * local_center;
+  cuboid.center = cuboid.rotation * local_center;
   BuiltEllipsoid out;
   out.cuboid = cuboid;
   out.ellipsoid = cuboid.inscribedEllipsoid();

@@ -1,0 +1,144 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/mapping/box_ellipsoid_builder.hpp"
+#include "ellreloc/mapping/ellipsoid_builder.hpp"
+
+namespace ellreloc {
+namespace {
+
+/// Points on the five visible faces (no bottom) of a cuboid, plus a few far outliers.
+std::vector<Eigen::Vector3d> cuboidSurface(const Cuboid& c, int per_face, int outliers, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> pts;
+  for (int face = 0; face < 5; ++face) {
+    const int axis = face / 2, sign = face % 2 ? 1 : -1;
+    const int ax = face == 4 ? 2 : axis;
+    for (int i = 0; i < per_face; ++i) {
+      Eigen::Vector3d s(u(rng), u(rng), u(rng));
+      s(ax) = face == 4 ? 1.0 : sign;
+      pts.push_back(c.center + c.rotation * s.cwiseProduct(c.half));
+    }
+  }
+  for (int i = 0; i < outliers; ++i) pts.push_back(c.center + Eigen::Vector3d(u(rng), u(rng), u(rng)) * 3.0);
+  return pts;
+}
+
+double axisAngleModPiDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / M_PI;
+}
+
+TEST(EllipsoidBuilder, RecoversYawCentreAndExtentsOfACuboid) {
+  std::mt19937 rng(3);
+  for (const Eigen::Vector3d& up : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.2, -0.1, 1.0).normalized()}) {
+    for (double yaw : {0.3, 1.2, -2.0}) {
+      Cuboid truth;
+      const Eigen::Matrix3d B = groundBasis(up);
+      truth.rotation = B * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      truth.half = Eigen::Vector3d(0.4, 0.15, 0.25);
+      truth.center = Eigen::Vector3d(1.0, -0.5, 0.25);
+      EllipsoidBuilderOptions opt;
+      opt.up = up;
+      const auto built = buildEllipsoid(cuboidSurface(truth, 2000, 10, rng), opt);
+      ASSERT_TRUE(built);
+      EXPECT_LT(axisAngleModPiDeg(built->cuboid.rotation.col(0), truth.rotation.col(0)), 1.0) << yaw;
+      EXPECT_LT(axisAngleModPiDeg(built->cuboid.rotation.col(2), up), 1e-9);
+      EXPECT_LT((built->cuboid.center - truth.center).norm(), 0.01);
+      EXPECT_NEAR(built->cuboid.half(0), 0.4, 0.01);
+      EXPECT_NEAR(built->cuboid.half(1), 0.15, 0.01);
+      EXPECT_NEAR(built->cuboid.half(2), 0.25, 0.01);
+      EXPECT_TRUE(isRotation(built->cuboid.rotation));
+      // The ellipsoid is the inscribed one: it touches the cuboid's face centres.
+      const Ellipsoid& e = built->ellipsoid;
+      const Eigen::Vector3d face = built->cuboid.center + built->cuboid.rotation.col(0) * built->cuboid.half(0);
+      const Eigen::Vector3d d = e.rotation().transpose() * (face - e.center());
+      EXPECT_NEAR(d.cwiseQuotient(e.axes()).norm(), 1.0, 1e-9);
+      const auto corners = built->cuboid.corners();
+      for (const auto& corner : corners)
+        EXPECT_NEAR((built->cuboid.rotation.transpose() * (corner - built->cuboid.center))
+                        .cwiseAbs()
+                        .cwiseQuotient(built->cuboid.half)
+                        .sum(),
+                    3.0, 1e-9);
+    }
+  }
+}
+
+TEST(EllipsoidBuilder, RefusesTooFewPointsAndABadUpVector) {
+  std::vector<Eigen::Vector3d> few(5, Eigen::Vector3d::Zero());
+  EXPECT_FALSE(buildEllipsoid(few));
+  std::vector<Eigen::Vector3d> flat;
+  for (int i = 0; i < 50; ++i) flat.emplace_back(0.01 * i, 0.0, 0.0);  // a line: no width
+  EXPECT_FALSE(buildEllipsoid(flat));
+  std::mt19937 rng(1);
+  Cuboid c;
+  c.half = Eigen::Vector3d(0.2, 0.1, 0.1);
+  EllipsoidBuilderOptions opt;
+  opt.up = Eigen::Vector3d::Zero();
+  EXPECT_FALSE(buildEllipsoid(cuboidSurface(c, 50, 0, rng), opt));
+  opt.up = Eigen::Vector3d(std::nan(""), 0, 1);
+  EXPECT_FALSE(buildEllipsoid(cuboidSurface(c, 50, 0, rng), opt));
+}
+
+const Intrinsics kK(525.0, 525.0, 319.5, 239.5, 640, 480);
+
+/// Views of an ellipsoid from a ring of cameras, with the bounding boxes of its projections.
+std::vector<BoxView> ringViews(const Ellipsoid& e, int n, double radius, double spread_deg) {
+  std::vector<BoxView> views;
+  for (int i = 0; i < n; ++i) {
+    const double a = (spread_deg * M_PI / 180.0) * (static_cast<double>(i) / std::max(1, n - 1) - 0.5);
+    const Eigen::Vector3d eye = e.center() + Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), 0.6);
+    const Pose pose = Pose::lookAt(eye, e.center());
+    const Projection p = project(e, kK, pose);
+    if (!p) continue;
+    const Eigen::Matrix2d S = p.ellipse.covariance();
+    const Eigen::Vector2d h(std::sqrt(S(0, 0)), std::sqrt(S(1, 1)));
+    views.push_back({pose, Box(p.ellipse.center().x() - h.x(), p.ellipse.center().y() - h.y(),
+                               p.ellipse.center().x() + h.x(), p.ellipse.center().y() + h.y())});
+  }
+  return views;
+}
+
+TEST(BoxEllipsoidBuilder, RecoversAnEllipsoidFromItsBoxes) {
+  const Ellipsoid truth(Eigen::Vector3d(0.5, 1.0, 0.4), Eigen::Vector3d(0.3, 0.15, 0.2),
+                        Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix());
+  const std::vector<BoxView> views = ringViews(truth, 10, 2.0, 120.0);
+  const auto centre = triangulateBoxCentres(kK, views);
+  ASSERT_TRUE(centre);
+  EXPECT_LT((*centre - truth.center()).norm(), 0.05);  // box centres are near, not at, the centre's image
+  const BoxEllipsoidResult r = buildEllipsoidFromBoxes(kK, views);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_LT((r.ellipsoid.center() - truth.center()).norm(), 0.02);
+  EXPECT_GT(r.median_iou, 0.9);
+  EXPECT_NEAR(r.ellipsoid.volume(), truth.volume(), 0.25 * truth.volume());
+  EXPECT_EQ(r.views_used, 10);
+  EXPECT_GT(r.baseline_deg, 100.0);
+}
+
+TEST(BoxEllipsoidBuilder, StatusesInsteadOfGuesses) {
+  const Ellipsoid truth(Eigen::Vector3d(0.5, 1.0, 0.4), Eigen::Vector3d(0.3, 0.15, 0.2), Eigen::Matrix3d::Identity());
+  EXPECT_EQ(buildEllipsoidFromBoxes(kK, ringViews(truth, 2, 2.0, 60.0)).status, BoxEllipsoidStatus::TooFewViews);
+  EXPECT_EQ(buildEllipsoidFromBoxes(kK, ringViews(truth, 5, 2.0, 1.0)).status, BoxEllipsoidStatus::NoBaseline);
+  EXPECT_EQ(buildEllipsoidFromBoxes(Intrinsics(), ringViews(truth, 5, 2.0, 60.0)).status,
+            BoxEllipsoidStatus::InvalidInput);
+  // Boxes that belong to no single object: each view shows a different place.
+  std::vector<BoxView> views = ringViews(truth, 6, 2.0, 90.0);
+  for (size_t i = 0; i < views.size(); ++i) {
+    const double shift = (i % 2 ? 1.0 : -1.0) * 150.0;
+    views[i].box = Box(views[i].box.x1 + shift, views[i].box.y1, views[i].box.x2 + shift, views[i].box.y2);
+  }
+  const BoxEllipsoidResult bad = buildEllipsoidFromBoxes(kK, views);
+  EXPECT_NE(bad.status, BoxEllipsoidStatus::Ok);
+  // Non-finite boxes are skipped, never propagated.
+  std::vector<BoxView> with_nan = ringViews(truth, 6, 2.0, 90.0);
+  with_nan[0].box.x1 = std::nan("");
+  const BoxEllipsoidResult r = buildEllipsoidFromBoxes(kK, with_nan);
+  EXPECT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(r.views_used, 5);
+}
+
+}  // namespace
+}  // namespace ellreloc

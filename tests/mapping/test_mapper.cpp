@@ -1,0 +1,216 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <atomic>
+#include <thread>
+
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/map.hpp"
+#include "ellreloc/mapping/mapper.hpp"
+#include "io/temp_dir.hpp"
+#include "mapping/sim_sequence.hpp"
+
+namespace ellreloc {
+namespace {
+
+/// Map objects within `radius` of a ground-truth object.
+int objectsNear(const ObjectMap& map, const Eigen::Vector3d& centre, double radius) {
+  int n = 0;
+  for (const MapObject& o : map.objects) n += (o.ellipsoid.center() - centre).norm() < radius;
+  return n;
+}
+
+TEST(Mapper, MapsARenderedOfficeWithNoisyDepthAndMasks) {
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Office, 3, 40, test::mappingNoise());
+  Mapper mapper(seq.K);
+  std::vector<int> seen(seq.scene.objects.size(), 0);
+  for (const auto& kf : seq.keyframes) {
+    mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
+    for (const auto& d : kf.detections) ++seen[static_cast<size_t>(*d.object_id)];
+  }
+  const ObjectMap map = mapper.map();
+  int checked = 0;
+  for (size_t i = 0; i < seq.scene.objects.size(); ++i) {
+    if (seen[i] < 10) continue;
+    const sim::SimObject& truth = seq.scene.objects[i];
+    ++checked;
+    const MapObject* best = nullptr;
+    for (const MapObject& o : map.objects)
+      if (!best ||
+          (o.ellipsoid.center() - truth.box_center).norm() < (best->ellipsoid.center() - truth.box_center).norm())
+        best = &o;
+    ASSERT_TRUE(best);
+    EXPECT_LT((best->ellipsoid.center() - truth.box_center).norm(), 0.06) << truth.label;
+    EXPECT_EQ(best->category, truth.category) << truth.label;
+    EXPECT_LE(objectsNear(map, truth.box_center, 0.1), 1) << "duplicate of " << truth.label;
+    for (int k = 0; k < 3; ++k) EXPECT_LT(best->ellipsoid.axes().maxCoeff(), truth.box_half.maxCoeff() + 0.1);
+  }
+  EXPECT_GE(checked, 10);
+  EXPECT_LE(map.objects.size(), static_cast<size_t>(checked) + 3);
+  // Memory is reported per object, and the label histograms are kept.
+  for (const MappedObject& m : mapper.objects()) {
+    EXPECT_GT(m.memory_bytes, 0u);
+    EXPECT_GE(m.observations, 3);
+    EXPECT_FALSE(m.object.category_counts.empty());
+    ASSERT_TRUE(m.cuboid);
+  }
+}
+
+TEST(Mapper, LabelNoiseDoesNotSplitObjectsOrChangeTheirLabel) {
+  sim::NoiseModel noise = test::mappingNoise();
+  noise.label_confusion = 0.2;
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 2, 40, noise);
+  Mapper mapper(seq.K);
+  std::vector<int> seen(seq.scene.objects.size(), 0);
+  for (const auto& kf : seq.keyframes) {
+    mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
+    for (const auto& d : kf.detections) ++seen[static_cast<size_t>(*d.object_id)];
+  }
+  const ObjectMap map = mapper.map();
+  for (size_t i = 0; i < seq.scene.objects.size(); ++i) {
+    if (seen[i] < 10) continue;
+    const sim::SimObject& truth = seq.scene.objects[i];
+    EXPECT_EQ(objectsNear(map, truth.box_center, 0.15), 1) << truth.label;
+    for (const MapObject& o : map.objects)
+      if ((o.ellipsoid.center() - truth.box_center).norm() < 0.15) EXPECT_EQ(o.category, truth.category);
+  }
+}
+
+/// One box on the floor, seen, then out of view, then seen again from the other side.
+TEST(Mapper, AnObjectLeavingAndReenteringTheViewIsFoundAgainIn3D) {
+  sim::Scene scene;
+  sim::SimObject box;
+  box.id = 0;
+  box.category = 24;
+  box.label = "backpack";
+  box.box_center = Eigen::Vector3d(0.0, 0.0, 0.25);
+  box.box_half = Eigen::Vector3d(0.25, 0.15, 0.25);
+  box.parts.push_back({sim::PrimitiveShape::Box, box.box_center, box.box_half, Eigen::Matrix3d::Identity()});
+  scene.objects.push_back(box);
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  std::vector<Pose> poses;
+  for (int i = 0; i < 12; ++i) {
+    const double a = -0.3 + 0.1 * i;  // an arc around the box
+    const Eigen::Vector3d eye(2.0 * std::cos(a), 2.0 * std::sin(a), 1.2);
+    const bool away = i >= 4 && i < 8;
+    poses.push_back(Pose::lookAt(eye, away ? Eigen::Vector3d(2 * eye.x(), 2 * eye.y(), 1.2) : box.box_center));
+  }
+  Mapper mapper(K);
+  std::mt19937_64 rng(1);
+  int matched_3d = 0, created = 0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const sim::RenderedFrame frame = sim::render(scene, K, poses[i]);
+    const auto detections = sim::detect(scene, frame, sim::NoiseModel(), rng);
+    const io::DepthImage depth = sim::noisyDepth(frame, sim::NoiseModel(), rng);
+    if (i >= 4 && i < 8) {
+      EXPECT_TRUE(detections.empty());
+    }
+    const KeyframeReport r = mapper.addKeyframe(poses[i], detections, &depth);
+    matched_3d += r.matched_3d;
+    created += r.new_objects;
+  }
+  EXPECT_EQ(created, 1);
+  EXPECT_EQ(matched_3d, 1);  // the first frame after the gap
+  const ObjectMap map = mapper.map();
+  ASSERT_EQ(map.objects.size(), 1u);
+  EXPECT_LT((map.objects[0].ellipsoid.center() - box.box_center).norm(), 0.03);
+  EXPECT_EQ(map.objects[0].category, 24);
+}
+
+TEST(Mapper, BoxesOnlyMode) {
+  sim::NoiseModel noise;
+  noise.box_jitter_px = 1.0;
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 4, 30, noise);
+  MapperOptions opt;
+  opt.mode = MappingMode::Boxes;
+  Mapper mapper(seq.K, opt);
+  std::vector<int> seen(seq.scene.objects.size(), 0);
+  for (const auto& kf : seq.keyframes) {
+    mapper.addKeyframe(kf.pose, kf.detections);  // no depth needed
+    for (const auto& d : kf.detections) ++seen[static_cast<size_t>(*d.object_id)];
+  }
+  const ObjectMap map = mapper.map();
+  int found = 0, expected = 0;
+  for (size_t i = 0; i < seq.scene.objects.size(); ++i) {
+    if (seen[i] < 10) continue;
+    ++expected;
+    found += objectsNear(map, seq.scene.objects[i].box_center, 0.1) >= 1;
+  }
+  EXPECT_GE(expected, 3);
+  EXPECT_GE(found, expected - 1);
+}
+
+TEST(Mapper, BadKeyframesAreErrorsAndLeaveTheMapUnchanged) {
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 1, 3, sim::NoiseModel());
+  Mapper mapper(seq.K);
+  const auto& kf = seq.keyframes[0];
+  mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
+  const MapperStats before = mapper.stats();
+
+  io::DepthImage zeros = kf.depth;
+  std::fill(zeros.metres.begin(), zeros.metres.end(), 0.0f);
+  EXPECT_THROW(mapper.addKeyframe(kf.pose, kf.detections, &zeros), Error);
+  EXPECT_THROW(mapper.addKeyframe(kf.pose, kf.detections, nullptr), Error);
+  io::DepthImage small = kf.depth;
+  small.width = 320;
+  EXPECT_THROW(mapper.addKeyframe(kf.pose, kf.detections, &small), Error);
+  const double nan = std::nan("");
+  EXPECT_THROW(
+      mapper.addKeyframe(Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, nan, 0)), kf.detections, &kf.depth),
+      Error);
+  ASSERT_FALSE(kf.detections.empty());
+  auto wrong_mask = kf.detections;
+  wrong_mask[0].mask->width = 320;
+  wrong_mask[0].mask->height = 960;  // same pixel count, other size
+  try {
+    mapper.addKeyframe(kf.pose, wrong_mask, &kf.depth);
+    FAIL() << "a mask of another size was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mask is 320x960, camera is 640x480"), std::string::npos) << e.what();
+  }
+  const MapperStats after = mapper.stats();
+  EXPECT_EQ(after.keyframes, before.keyframes);
+  EXPECT_EQ(after.voxels, before.voxels);
+  EXPECT_THROW(Mapper{Intrinsics()}, Error);
+}
+
+TEST(Mapper, ReadsWhileMappingAndExportToTheMapFormat) {
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 5, 30, test::mappingNoise());
+  Mapper mapper(seq.K);
+  std::atomic<bool> done(false);
+  std::atomic<long> reads(0);
+  std::thread reader([&] {
+    while (!done) {
+      const ObjectMap m = mapper.map();
+      for (const MapObject& o : m.objects) ASSERT_TRUE(o.ellipsoid.isValid());
+      ++reads;
+    }
+  });
+  for (const auto& kf : seq.keyframes) mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
+  done = true;
+  reader.join();
+  EXPECT_GT(reads.load(), 0);
+
+  // The same keyframes mapped serially give the same map.
+  Mapper serial(seq.K);
+  for (const auto& kf : seq.keyframes) serial.addKeyframe(kf.pose, kf.detections, &kf.depth);
+  const ObjectMap a = mapper.map(), b = serial.map();
+  ASSERT_EQ(a.objects.size(), b.objects.size());
+  ASSERT_FALSE(a.objects.empty());
+  for (size_t i = 0; i < a.objects.size(); ++i)
+    EXPECT_LT((a.objects[i].ellipsoid.center() - b.objects[i].ellipsoid.center()).norm(), 1e-12);
+
+  test::TempDir dir;
+  const std::string path = dir.path("map.json");
+  io::writeMap(path, a);
+  const ObjectMap back = io::readMap(path);
+  ASSERT_EQ(back.objects.size(), a.objects.size());
+  for (size_t i = 0; i < a.objects.size(); ++i) {
+    EXPECT_EQ(back.objects[i].category, a.objects[i].category);
+    EXPECT_LT((back.objects[i].ellipsoid.center() - a.objects[i].ellipsoid.center()).norm(), 1e-9);
+    EXPECT_LT((back.objects[i].ellipsoid.axes() - a.objects[i].ellipsoid.axes()).norm(), 1e-9);
+  }
+}
+
+}  // namespace
+}  // namespace ellreloc

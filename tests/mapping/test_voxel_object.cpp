@@ -1,0 +1,189 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "ellreloc/error.hpp"
+#include "ellreloc/mapping/voxel_object.hpp"
+
+namespace ellreloc {
+namespace {
+
+const Intrinsics kK(500.0, 500.0, 319.5, 239.5, 640, 480);
+
+io::DepthImage flatDepth(float metres) {
+  io::DepthImage d;
+  d.width = kK.width;
+  d.height = kK.height;
+  d.metres.assign(static_cast<size_t>(d.width) * d.height, metres);
+  return d;
+}
+
+BinaryMask rectMask(int x1, int y1, int x2, int y2) {
+  BinaryMask m(kK.height, kK.width);
+  for (int y = y1; y <= y2; ++y)
+    for (int x = x1; x <= x2; ++x) m.at(x, y) = 1;
+  return m;
+}
+
+/// Eq. 1 of the paper with prior 0.5: the posterior after an observation with P(n | z) = pz.
+double bayes(double prior, double pz) { return 1.0 / (1.0 + (1.0 - pz) / pz * (1.0 - prior) / prior); }
+
+TEST(VoxelObject, HitsFollowTheBayesFilterAndClamp) {
+  VoxelObject v;
+  const Pose camera;  // at the origin, looking along +z
+  const BinaryMask mask = rectMask(300, 220, 340, 260);
+  const Eigen::Vector3d on_plane(0.001, 0.001, 2.005);  // well inside one voxel
+  v.integrate(kK, camera, flatDepth(2.005f), mask);
+  EXPECT_NEAR(v.probabilityAt(on_plane), 0.7, 1e-6);
+  v.integrate(kK, camera, flatDepth(2.005f), mask);
+  EXPECT_NEAR(v.probabilityAt(on_plane), bayes(0.7, 0.7), 1e-6);
+  for (int i = 0; i < 20; ++i) v.integrate(kK, camera, flatDepth(2.005f), mask);
+  EXPECT_NEAR(v.probabilityAt(on_plane), 0.97, 1e-6);                // OctoMap-style clamping
+  EXPECT_DOUBLE_EQ(v.probabilityAt(Eigen::Vector3d(0, 0, 5)), 0.5);  // unknown
+}
+
+TEST(VoxelObject, VoxelsLieOnTheBackProjectedSurfaceAndProjectToTheMask) {
+  VoxelObject v;
+  const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
+  const BinaryMask mask = rectMask(250, 200, 390, 300);
+  const auto up = v.integrate(kK, camera, flatDepth(2.5f), mask);
+  EXPECT_EQ(up.hits, up.added);
+  ASSERT_GT(v.size(), 100u);
+  const double half_diagonal = std::sqrt(3.0) * 0.5 * v.options().voxel_size;
+  for (const Eigen::Vector3d& c : v.occupiedCentres()) {
+    // Independent check: the voxel centre is within half a voxel diagonal of the plane z_c = 2.5.
+    EXPECT_LE(std::abs(camera.transform(c).z() - 2.5), half_diagonal + 1e-9);
+  }
+  const auto box = v.projectedBox(kK, camera);
+  ASSERT_TRUE(box);
+  const double voxel_px = 500.0 * v.options().voxel_size / 2.5;  // one voxel at that depth
+  EXPECT_NEAR(box->x1, 250, voxel_px);
+  EXPECT_NEAR(box->x2, 390, voxel_px);
+  EXPECT_NEAR(box->y1, 200, voxel_px);
+  EXPECT_NEAR(box->y2, 300, voxel_px);
+}
+
+TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {
+  const Pose camera;
+  const BinaryMask full = rectMask(300, 220, 340, 260);
+  // Points well inside two voxels: the left one's centre (-0.05, 0.01, 2.01) projects to x = 307,
+  // inside `full` only; the right one's (0.07, 0.01, 2.01) to x = 337, inside both masks.
+  const Eigen::Vector3d left(-0.051, 0.001, 2.005);
+  const Eigen::Vector3d right(0.071, 0.001, 2.005);
+  {
+    VoxelObject v;
+    v.integrate(kK, camera, flatDepth(2.005f), full);
+    v.integrate(kK, camera, flatDepth(2.005f), rectMask(320, 220, 340, 260));
+    EXPECT_NEAR(v.probabilityAt(left), bayes(0.7, 0.3), 1e-6);  // seen outside the mask
+    EXPECT_NEAR(v.probabilityAt(right), bayes(0.7, 0.7), 1e-6);
+  }
+  {
+    VoxelObject v;
+    v.integrate(kK, camera, flatDepth(2.005f), full);
+    v.integrate(kK, camera, flatDepth(3.005f), full);  // the surface moved back: free space
+    EXPECT_NEAR(v.probabilityAt(left), bayes(0.7, 0.3), 1e-6);
+  }
+  {
+    VoxelObject v;
+    v.integrate(kK, camera, flatDepth(2.005f), full);
+    v.integrate(kK, camera, flatDepth(1.0f), rectMask(0, 0, 10, 10));  // something in front hides it
+    EXPECT_NEAR(v.probabilityAt(left), 0.7, 1e-6);
+  }
+  {
+    VoxelObject v;
+    v.integrate(kK, camera, flatDepth(2.005f), full);
+    const auto up = v.integrate(kK, camera, flatDepth(0.0f), rectMask(0, 0, 10, 10));  // no reading
+    EXPECT_EQ(up.hits + up.misses, 0);
+    EXPECT_NEAR(v.probabilityAt(left), 0.7, 1e-6);
+  }
+}
+
+TEST(VoxelObject, DepthGateDropsMaskPixelsOnTheBackground) {
+  io::DepthImage depth = flatDepth(2.005f);
+  for (int y = 0; y < kK.height; ++y)
+    for (int x = 0; x < 310; ++x) depth.metres[static_cast<size_t>(y) * kK.width + x] = 4.0f;  // a wall behind
+  VoxelObject v;
+  v.integrate(kK, Pose(), depth, rectMask(300, 220, 360, 260));  // a sixth of the mask bleeds onto the wall
+  for (const Eigen::Vector3d& c : v.occupiedCentres()) EXPECT_LT(c.z(), 2.1);
+  VoxelOptions no_gate;
+  no_gate.depth_gate_sigmas = 0.0;
+  VoxelObject w(no_gate);
+  w.integrate(kK, Pose(), depth, rectMask(300, 220, 360, 260));
+  EXPECT_GT(w.size(), v.size());
+}
+
+TEST(VoxelObject, CountNearIsEquationFourCounting) {
+  VoxelObject a, b, far;
+  a.integrate(kK, Pose(), flatDepth(2.005f), rectMask(300, 220, 340, 260));
+  b.integrate(kK, Pose(), flatDepth(2.005f), rectMask(320, 220, 360, 260));  // half overlapping
+  far.integrate(kK, Pose(), flatDepth(3.005f), rectMask(300, 220, 340, 260));
+  const long n = static_cast<long>(a.occupiedCount());
+  EXPECT_EQ(a.countNear(a, 0.0), n);
+  EXPECT_EQ(a.countNear(far, 0.05), 0);
+  // b covers x >= 320 px; a's voxels with x_c >= (320 - 319.5) / 500 * 2 - r are near b's.
+  long expected = 0;
+  for (const Eigen::Vector3d& c : a.occupiedCentres()) {
+    bool near = false;
+    for (const Eigen::Vector3d& d : b.occupiedCentres()) near = near || (c - d).norm() <= 0.05 + 1e-9;
+    expected += near;
+  }
+  EXPECT_EQ(a.countNear(b, 0.05), expected);
+  EXPECT_GT(expected, n / 3);
+  EXPECT_LT(expected, n);
+}
+
+TEST(VoxelObject, PruneAndMemoryBudget) {
+  VoxelOptions small;
+  small.max_voxels = 100;
+  VoxelObject v(small);
+  v.integrate(kK, Pose(), flatDepth(2.005f), rectMask(200, 200, 400, 300));
+  EXPECT_LE(v.size(), 100u);
+  EXPECT_GT(v.memoryBytes(), 100u * 8u);
+  VoxelObject w;
+  w.integrate(kK, Pose(), flatDepth(2.005f), rectMask(300, 220, 340, 260));
+  w.integrate(kK, Pose(), flatDepth(2.005f), rectMask(320, 220, 340, 260));
+  const size_t before = w.size();
+  const size_t removed = w.prune(0.6);  // the left half dropped to 0.5
+  EXPECT_GT(removed, 0u);
+  EXPECT_EQ(w.size(), before - removed);
+  for (const Eigen::Vector3d& c : w.occupiedCentres()) EXPECT_GT(c.x(), -0.01);
+}
+
+TEST(VoxelObject, BadInputIsAnErrorNotACrash) {
+  VoxelObject v;
+  const BinaryMask mask = rectMask(300, 220, 340, 260);
+  BinaryMask wrong(240, 320);
+  EXPECT_THROW(v.integrate(kK, Pose(), flatDepth(2.005f), wrong), Error);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(v.integrate(kK, Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0)), flatDepth(2.005f), mask),
+               Error);
+  io::DepthImage small = flatDepth(2.005f);
+  small.width = 320;
+  EXPECT_THROW(v.integrate(kK, Pose(), small, mask), Error);
+  EXPECT_EQ(v.size(), 0u);
+  io::DepthImage nan_depth = flatDepth(std::numeric_limits<float>::quiet_NaN());
+  EXPECT_EQ(v.integrate(kK, Pose(), nan_depth, mask).hits, 0);
+}
+
+TEST(VoxelObject, MajorityFilterAndBoxMasks) {
+  BinaryMask m = rectMask(100, 100, 120, 120);
+  m.at(110, 110) = 0;  // a pinhole
+  m.at(50, 50) = 1;    // a speck
+  const BinaryMask f = majorityFiltered(m);
+  EXPECT_EQ(f.at(110, 110), 1);
+  EXPECT_EQ(f.at(50, 50), 0);
+  EXPECT_EQ(f.at(105, 105), 1);
+  EXPECT_EQ(f.at(100, 100), 0);  // a corner has 4 of 9 votes
+  // A box [x1, x2] holds the pixels whose centres lie inside it.
+  const BinaryMask b = maskFromBox(Box(9.5, 19.5, 14.5, 29.5), 640, 480);
+  EXPECT_EQ(b.x0, 10);
+  EXPECT_EQ(b.y0, 20);
+  EXPECT_EQ(b.width, 5);
+  EXPECT_EQ(b.height, 10);
+  EXPECT_EQ(b.count(), 50);
+  EXPECT_EQ(maskFromBox(Box(700, 10, 800, 20), 640, 480).count(), 0);
+}
+
+}  // namespace
+}  // namespace ellreloc
