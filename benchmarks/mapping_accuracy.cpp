@@ -88,9 +88,10 @@ void score(const std::vector<Ellipsoid>& est, const std::vector<int>& est_catego
 }
 
 void printRow(const char* name, const Errors& e) {
-  std::printf("| %s | %d / %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f |\n", name, e.found, e.expected, e.spurious,
+  const std::string rate = e.keyframes > 0 ? std::to_string(static_cast<int>(e.keyframes / e.seconds)) : "-";
+  std::printf("| %s | %d / %d | %d | %.1f | %.1f | %.1f | %.1f | %s |\n", name, e.found, e.expected, e.spurious,
               100.0 * median(e.centre), median(e.yaw), 100.0 * median(e.axis), 100.0 * median(e.axis_large),
-              e.keyframes > 0 ? e.keyframes / e.seconds : 0.0);
+              rate.c_str());
 }
 
 }  // namespace

@@ -112,8 +112,10 @@ int main(int argc, char** argv) {
   std::string data = ELLRELOC_BENCH_DATA_DIR;
   bool ours_only = false;  // skip the slow exhaustive preset (for timing runs of ours)
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--ours-only") ours_only = true;
-    else data = argv[i];
+    if (std::string(argv[i]) == "--ours-only")
+      ours_only = true;
+    else
+      data = argv[i];
   }
   const auto fr2 = bench::loadFr2Desk(data);
   std::printf(
