@@ -1,0 +1,157 @@
+// End-to-end tests of the `ellreloc` command: every subcommand on a small simulated scene,
+// the real fr2_desk regression guard, and the bad-input table (exit code 2, one line, no file).
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "io/temp_dir.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+CliRun run(const std::string& args, const ellreloc::test::TempDir& dir) {
+  const std::string out = dir.path("stdout.txt"), err = dir.path("stderr.txt");
+  const std::string cmd = std::string(ELLRELOC_CLI) + " " + args + " >" + out + " 2>" + err;
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream o(out), e(err);
+  std::stringstream so, se;
+  so << o.rdbuf();
+  se << e.rdbuf();
+  r.out = so.str();
+  r.err = se.str();
+  return r;
+}
+
+int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+std::string data(const std::string& name) { return std::string(ELLRELOC_TEST_DATA_DIR) + "/" + name; }
+
+void writeFile(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
+  ellreloc::test::TempDir dir;
+  const std::string s = dir.path("scene");
+  CliRun r =
+      run("simulate --preset sparse --seed 2 --noise realistic --mapping-frames 24 --query-frames 12 --out " + s, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("query/detections.json"), std::string::npos);
+  ASSERT_TRUE(fs::exists(s + "/mapping/associations.txt"));
+
+  r = run("observe --camera " + s + "/camera.yaml --detections " + s + "/query/detections.json --policy paper --out " +
+              dir.path("observed.json"),
+          dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream observed(dir.path("observed.json"));
+  const std::string text((std::istreambuf_iterator<char>(observed)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"ellipse\""), std::string::npos);
+  EXPECT_NE(text.find("\"regular\""), std::string::npos);
+
+  for (const std::string mode : {"voxel", "boxes"}) {
+    r = run("map --camera " + s + "/camera.yaml --associations " + s + "/mapping/associations.txt --trajectory " + s +
+                "/mapping/trajectory.txt --detections " + s + "/mapping/detections.json --mode " + mode + " --out " +
+                dir.path("map_" + mode + ".json"),
+            dir);
+    ASSERT_EQ(r.code, 0) << mode << ": " << r.err;
+    EXPECT_NE(r.out.find("objects from 24 keyframes"), std::string::npos) << r.out;
+  }
+  for (const std::string method : {"ours", "oa-slam"}) {
+    r = run("relocalize --camera " + s + "/camera.yaml --map " + dir.path("map_voxel.json") + " --detections " + s +
+                "/query/detections.json --method " + method + " --threads 2 --out " + dir.path(method + ".txt") +
+                " --report " + dir.path(method + ".json"),
+            dir);
+    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+    EXPECT_TRUE(fs::exists(dir.path(method + ".json")));
+    r = run("evaluate --groundtruth " + s + "/query/groundtruth.txt --estimate " + dir.path(method + ".txt") +
+                " --detections " + s + "/query/detections.json --plot " + dir.path(method + ".png"),
+            dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("valid %"), std::string::npos);
+    EXPECT_GT(fs::file_size(dir.path(method + ".png")), 1000u);
+  }
+  r = run("--help", dir);
+  EXPECT_EQ(r.code, 0);
+  for (const std::string sub : {"simulate", "observe", "map", "relocalize", "evaluate", "demo"}) {
+    r = run(sub + " --help", dir);
+    EXPECT_EQ(r.code, 0) << sub;
+    EXPECT_NE(r.out.find("Example: ellreloc " + sub), std::string::npos) << sub;
+  }
+}
+
+// A regression guard on real data: 64.1% valid when measured (docs/benchmarks.md); the floor
+// leaves room for platform differences in floating point, not for a worse method.
+TEST(Cli, Fr2DeskKeyframesStayAboveTheMeasuredFloor) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr2_desk");
+  CliRun r = run("relocalize --camera " + d + "/camera.yaml --map " + d + "/map.json --detections " + d +
+                     "/keyframes.detections.json --threads 2 --out " + dir.path("poses.txt"),
+                 dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("evaluate --groundtruth " + d + "/keyframes.groundtruth.txt --estimate " + dir.path("poses.txt") +
+              " --detections " + d + "/keyframes.detections.json",
+          dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string last = r.out.substr(r.out.rfind("\n|", r.out.size() - 2) + 1);
+  double pos = 0, rot = 0, valid = 0;
+  ASSERT_EQ(std::sscanf(last.c_str(), "| %lf | %lf | %lf", &pos, &rot, &valid), 3) << r.out;
+  EXPECT_GE(valid, 60.0);
+  EXPECT_LE(pos, 15.0);
+}
+
+TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr2_desk");
+  writeFile(dir.path("empty.json"), "");
+  writeFile(dir.path("truncated.json"), "[{\"file_name\": \"rgb/1.png\", \"detections\": [");
+  writeFile(dir.path("wrong_type.json"), "[{\"file_name\": \"rgb/1.png\", \"detections\": [{\"bbox\": \"wide\"}]}]");
+  writeFile(dir.path("nan.json"),
+            "[{\"file_name\": \"rgb/1.png\", \"detections\": [{\"category_id\": 1, \"bbox\": [1, 2, NaN, 4]}]}]");
+  writeFile(dir.path("negative_axes.json"),
+            "{\"objects\": [{\"id\": 0, \"category_id\": 1, \"center\": [0, 0, 0], \"axes\": [0.1, -0.2, 0.3], "
+            "\"rotation\": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}]}");
+  writeFile(dir.path("bad_camera.yaml"), "Camera.fx: -3\n");
+  const std::string out = dir.path("out.txt");
+  const std::string reloc = "relocalize --camera " + d + "/camera.yaml --out " + out + " ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"missing file", reloc + "--map " + d + "/map.json --detections " + dir.path("nope.json")},
+      {"empty file", reloc + "--map " + d + "/map.json --detections " + dir.path("empty.json")},
+      {"truncated JSON", reloc + "--map " + d + "/map.json --detections " + dir.path("truncated.json")},
+      {"wrong type", reloc + "--map " + d + "/map.json --detections " + dir.path("wrong_type.json")},
+      {"NaN", reloc + "--map " + d + "/map.json --detections " + dir.path("nan.json")},
+      {"negative axes",
+       reloc + "--map " + dir.path("negative_axes.json") + " --detections " + d + "/keyframes.detections.json"},
+      {"bad camera", "relocalize --camera " + dir.path("bad_camera.yaml") + " --out " + out + " --map " + d +
+                         "/map.json --detections " + d + "/keyframes.detections.json"},
+      {"unknown method",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --method x"},
+      {"unknown subcommand", "teleport --out " + out},
+      {"missing option", "relocalize --camera " + d + "/camera.yaml --out " + out},
+      {"bad thread count",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --threads 0"},
+      {"voxel map without depth", "map --camera " + d + "/camera.yaml --trajectory " + d +
+                                      "/keyframes.groundtruth.txt --detections " + d +
+                                      "/keyframes.detections.json --out " + out},
+      {"unknown preset", "simulate --preset mars --out " + dir.path("scene")},
+  };
+  for (const auto& [name, args] : cases) {
+    const CliRun r = run(args, dir);
+    EXPECT_EQ(r.code, 2) << name << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << name << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("ellreloc: ", 0), 0u) << name << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << name;
+    EXPECT_FALSE(fs::exists(dir.path("scene"))) << name;
+  }
+}
+
+}  // namespace
