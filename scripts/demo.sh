@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs missing dependencies, builds, and runs the main example.
+# Installs missing dependencies, builds, and runs `ellreloc demo`: simulate an office, map it,
+# relocalize 100 query frames with our method and the OA-SLAM baseline, print the comparison.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh
-"${ELLRELOC_BUILD_DIR:-build}/examples/minimal/ellreloc_minimal" "$@"
+"${ELLRELOC_BUILD_DIR:-build}/examples/cli/ellreloc" demo "$@"

@@ -88,7 +88,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& h) {
     return app.exit(h);
   } catch (const CLI::ParseError& err) {
-    std::fprintf(stderr, "ellreloc: %s (see --help)\n", err.what());
+    if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty())
+      std::fprintf(stderr, "ellreloc: unknown subcommand '%s' (see --help)\n", argv[1]);
+    else
+      std::fprintf(stderr, "ellreloc: %s (see --help)\n", err.what());
     return 2;
   }
   try {
