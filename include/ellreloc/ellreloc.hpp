@@ -14,6 +14,7 @@
 #include "ellreloc/io/trajectory.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
 #include "ellreloc/mapping/ellipsoid_builder.hpp"
+#include "ellreloc/mapping/gravity.hpp"
 #include "ellreloc/mapping/hungarian.hpp"
 #include "ellreloc/mapping/mapper.hpp"
 #include "ellreloc/mapping/object_tracker.hpp"

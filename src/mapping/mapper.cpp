@@ -77,6 +77,12 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
   std::unique_lock lock(mutex_);
   checkKeyframe(pose, detections, depth);
   KeyframeReport report;
+  if (options_.mode == MappingMode::Voxel && options_.estimate_up_from_floor) {
+    FloorOptions floor = options_.floor;
+    floor.prior_up = options_.ellipsoid.up;
+    floor.seed = options_.floor.seed + static_cast<uint64_t>(keyframes_);
+    if (const auto plane = estimateFloor(K_, pose, *depth, floor)) floor_normal_sum_ += plane->inlier_share * plane->up;
+  }
   if (options_.mode == MappingMode::Voxel)
     addVoxelKeyframe(pose, detections, *depth, &report);
   else
@@ -107,8 +113,9 @@ void Mapper::rebuild(Track& track) const {
   m.object.category_counts = track.labels;
   m.observations = track.observations;
   if (options_.mode == MappingMode::Voxel) {
-    const auto built =
-        buildEllipsoid(track.voxels.occupiedCentres(options_.ellipsoid_min_probability), options_.ellipsoid);
+    EllipsoidBuilderOptions builder = options_.ellipsoid;
+    if (floor_normal_sum_.norm() > 0.0) builder.up = floor_normal_sum_.normalized();
+    const auto built = buildEllipsoid(track.voxels.occupiedCentres(options_.ellipsoid_min_probability), builder);
     if (!built) return;  // keeps the previous ellipsoid, if any
     m.object.ellipsoid = built->ellipsoid;
     m.cuboid = built->cuboid;
@@ -274,6 +281,7 @@ MapperStats Mapper::stats() const {
   std::shared_lock lock(mutex_);
   MapperStats s;
   s.keyframes = keyframes_;
+  s.up = floor_normal_sum_.norm() > 0.0 ? floor_normal_sum_.normalized() : options_.ellipsoid.up.normalized();
   for (const Track& t : tracks_) {
     (t.confirmed && t.built ? s.objects : s.candidates) += 1;
     s.voxels += t.voxels.size();

@@ -25,6 +25,7 @@
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
 #include "ellreloc/mapping/ellipsoid_builder.hpp"
+#include "ellreloc/mapping/gravity.hpp"
 #include "ellreloc/mapping/object_tracker.hpp"
 #include "ellreloc/mapping/voxel_object.hpp"
 
@@ -51,6 +52,11 @@ struct MapperOptions {
   int track_window = 1;         ///< 2D tracking against objects seen in the last N keyframes
   int candidate_lifetime = 10;  ///< objects not yet in the map are forgotten after N keyframes unseen
   double min_score = 0.0;       ///< detections below this score are ignored
+  /// Voxel mode: estimate the up direction from the floor seen in the depth images (averaged
+  /// over keyframes, weighted by the floor's share of pixels) instead of trusting
+  /// ellipsoid.up, which is then only the prior. Objects are rebuilt with it when next updated.
+  bool estimate_up_from_floor = false;
+  FloorOptions floor;
   long min_mask_pixels = 30;    ///< smaller masks are ignored
 };
 
@@ -74,8 +80,9 @@ struct MappedObject {
 
 struct MapperStats {
   int keyframes = 0;
-  int objects = 0;     ///< in the map
-  int candidates = 0;  ///< seen fewer than min_observations times
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< the up direction the ellipsoids use
+  int objects = 0;                                ///< in the map
+  int candidates = 0;                             ///< seen fewer than min_observations times
   size_t voxels = 0;
   size_t memory_bytes = 0;
 };
@@ -124,6 +131,7 @@ class Mapper {
   std::vector<Track> tracks_;
   int keyframes_ = 0;
   int next_id_ = 0;
+  Eigen::Vector3d floor_normal_sum_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace ellreloc
