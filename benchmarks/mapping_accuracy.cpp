@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
       "keyframes/s |\n");
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const sim::ScenePreset preset : {sim::ScenePreset::Office, sim::ScenePreset::Cluttered}) {
-    Errors voxel, boxes, builder;
+    Errors voxel, voxel_rect, boxes, builder;
     for (int seed = 1; seed <= seeds; ++seed) {
       const test::SimSequence seq =
           test::makeSimSequence(preset, static_cast<uint64_t>(seed), frames, test::mappingNoise());
@@ -121,9 +121,10 @@ int main(int argc, char** argv) {
         for (const auto& d : kf.detections)
           if (d.object_id) ++seen[static_cast<size_t>(*d.object_id)], views[*d.object_id].push_back({kf.pose, d.bbox});
 
-      for (const MappingMode mode : {MappingMode::Voxel, MappingMode::Boxes}) {
+      for (Errors* e : {&voxel, &voxel_rect, &boxes}) {
         MapperOptions opt;
-        opt.mode = mode;
+        opt.mode = e == &boxes ? MappingMode::Boxes : MappingMode::Voxel;
+        if (e == &voxel_rect) opt.ellipsoid.yaw = YawMethod::MinAreaRectangle;
         Mapper mapper(seq.K, opt);
         const auto t0 = std::chrono::steady_clock::now();
         for (const auto& kf : seq.keyframes) mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
@@ -131,10 +132,9 @@ int main(int argc, char** argv) {
         std::vector<Ellipsoid> est;
         std::vector<int> cat;
         for (const MapObject& o : mapper.map().objects) est.push_back(o.ellipsoid), cat.push_back(o.category);
-        Errors& e = mode == MappingMode::Voxel ? voxel : boxes;
-        score(est, cat, seq.scene, seen, &e);
-        e.seconds += dt;
-        e.keyframes += static_cast<int>(seq.keyframes.size());
+        score(est, cat, seq.scene, seen, e);
+        e->seconds += dt;
+        e->keyframes += static_cast<int>(seq.keyframes.size());
       }
       // BoxEllipsoidBuilder alone, with the true associations.
       std::vector<Ellipsoid> est;
@@ -147,6 +147,7 @@ int main(int argc, char** argv) {
     }
     const std::string name = sim::toString(preset);
     printRow((name + " / voxel mapper (paper)").c_str(), voxel);
+    printRow((name + " / voxel mapper, min-area-rectangle yaw").c_str(), voxel_rect);
     printRow((name + " / boxes mapper").c_str(), boxes);
     printRow((name + " / BoxEllipsoidBuilder, true associations").c_str(), builder);
   }

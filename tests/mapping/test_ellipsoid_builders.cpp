@@ -142,3 +142,33 @@ TEST(BoxEllipsoidBuilder, StatusesInsteadOfGuesses) {
 
 }  // namespace
 }  // namespace ellreloc
+
+namespace ellreloc {
+namespace {
+
+// Two faces of a box seen from one corner: PCA tilts towards the diagonal, the smallest
+// enclosing rectangle does not.
+TEST(EllipsoidBuilder, MinAreaRectangleYawOnAnLShapedFootprint) {
+  Cuboid truth;
+  truth.rotation = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  truth.half = Eigen::Vector3d(0.4, 0.2, 0.3);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 10; ++j) {
+      const double s = -1.0 + i / 20.0, z = -1.0 + j / 5.0;
+      pts.push_back(truth.rotation * Eigen::Vector3d(s * 0.4, -0.2, z * 0.3));                  // long face
+      if (i % 2 == 0) pts.push_back(truth.rotation * Eigen::Vector3d(-0.4, s * 0.2, z * 0.3));  // short face
+    }
+  EllipsoidBuilderOptions rect;
+  rect.yaw = YawMethod::MinAreaRectangle;
+  const auto a = buildEllipsoid(pts, rect);
+  const auto b = buildEllipsoid(pts);
+  ASSERT_TRUE(a && b);
+  EXPECT_LT(axisAngleModPiDeg(a->cuboid.rotation.col(0), truth.rotation.col(0)), 0.01);
+  EXPECT_NEAR(a->cuboid.half(0), 0.4, 0.01);
+  EXPECT_NEAR(a->cuboid.half(1), 0.2, 0.01);
+  EXPECT_GT(axisAngleModPiDeg(b->cuboid.rotation.col(0), truth.rotation.col(0)), 1.0);  // PCA's bias
+}
+
+}  // namespace
+}  // namespace ellreloc

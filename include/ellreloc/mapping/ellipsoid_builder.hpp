@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -37,8 +38,15 @@ struct Cuboid {
   Ellipsoid inscribedEllipsoid() const { return Ellipsoid(center, half, rotation); }
 };
 
+/// How the yaw is found from the ground-plane footprint of the voxels.
+enum class YawMethod {
+  Pca,               ///< main axis of a (trimmed) PCA, the paper's method
+  MinAreaRectangle,  ///< the smallest rectangle around the trimmed footprint (rotating calipers)
+};
+
 struct EllipsoidBuilderOptions {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< against gravity, in world coordinates
+  YawMethod yaw = YawMethod::Pca;
   /// Extents span these percentiles of the voxel coordinates along each axis, which ignores
   /// a few outlier voxels that survived the label filter.
   double low_percentile = 0.01;
@@ -66,6 +74,45 @@ inline double quantile(std::vector<double> values, double q) {
   const double b = *std::min_element(values.begin() + static_cast<long>(lo) + 1, values.end());
   return a + (pos - static_cast<double>(lo)) * (b - a);
 }
+/// The direction of the longer side of the smallest-area rectangle enclosing 2D points: the
+/// rectangle has a side on an edge of the convex hull, so each hull edge is tried.
+inline std::optional<Eigen::Vector2d> minAreaRectangleAxis(std::vector<Eigen::Vector2d> p) {
+  std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (p.size() < 3) return std::nullopt;
+  const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::vector<Eigen::Vector2d> hull(2 * p.size());  // Andrew's monotone chain
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], p[i - 1]) <= 0) --k;
+    hull[k++] = p[i - 1];
+  }
+  hull.resize(k - 1);
+  if (hull.size() < 3) return std::nullopt;
+  double best_area = std::numeric_limits<double>::infinity();
+  Eigen::Vector2d best = Eigen::Vector2d::UnitX();
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
+    if (!(e.norm() > 0.0)) continue;
+    const Eigen::Vector2d u = e.normalized(), v(-u.y(), u.x());
+    double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
+    for (const Eigen::Vector2d& q : hull) {
+      u_lo = std::min(u_lo, u.dot(q)), u_hi = std::max(u_hi, u.dot(q));
+      v_lo = std::min(v_lo, v.dot(q)), v_hi = std::max(v_hi, v.dot(q));
+    }
+    const double area = (u_hi - u_lo) * (v_hi - v_lo);
+    if (area < best_area) best_area = area, best = (u_hi - u_lo) >= (v_hi - v_lo) ? u : v;
+  }
+  return best;
+}
+
 }  // namespace detail
 
 /// A right-handed world basis (e1, e2, up) with e1, e2 spanning the ground plane.
@@ -120,6 +167,21 @@ inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vec
                          detail::quantile(across, options.high_percentile));
     for (size_t i = 0; i < ground.size(); ++i)
       inlier[i] = along[i] >= lo.x() && along[i] <= hi.x() && across[i] >= lo.y() && across[i] <= hi.y();
+  }
+  if (options.yaw == YawMethod::MinAreaRectangle) {
+    std::vector<Eigen::Vector2d> footprint;
+    for (size_t i = 0; i < ground.size(); ++i)
+      if (inlier[i]) footprint.push_back(ground[i]);
+    const auto axis = detail::minAreaRectangleAxis(footprint);
+    if (!axis) return std::nullopt;
+    main = *axis;
+    const Eigen::Vector2d side(-main.y(), main.x());
+    std::vector<double> along(ground.size()), across(ground.size());
+    for (size_t i = 0; i < ground.size(); ++i) along[i] = main.dot(ground[i]), across[i] = side.dot(ground[i]);
+    lo = Eigen::Vector2d(detail::quantile(along, options.low_percentile),
+                         detail::quantile(across, options.low_percentile));
+    hi = Eigen::Vector2d(detail::quantile(along, options.high_percentile),
+                         detail::quantile(across, options.high_percentile));
   }
   const double yaw = std::atan2(main.y(), main.x());
 
