@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -175,6 +176,16 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "paper" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
+  // Keypoints per frame: from the detections file itself, or from a file with the same frames.
+  std::vector<std::vector<Keypoint>> keypoints(frames.size());
+  if (a.use_points) {
+    if (object_map.points.empty()) throw Error(a.map + ": --points needs a map with `points`");
+    std::map<std::string, std::vector<Keypoint>> by_name;
+    if (!a.points.empty())
+      for (const DetectionFrame& f : io::readDetections(a.points)) by_name[f.file_name] = f.keypoints;
+    for (size_t i = 0; i < frames.size(); ++i)
+      keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
+  }
 
   // Frames are independent: workers take the next frame until none is left.
   std::vector<RelocalizationResult> results(frames.size());
@@ -187,7 +198,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
         if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
           observations.push_back(*r.observation);
       observed[i] = static_cast<int>(observations.size());
-      results[i] = relocalizer.relocalize(observations);
+      results[i] = relocalizer.relocalize(observations, keypoints[i]);
       ++finished;
     }
   };
@@ -366,7 +377,14 @@ void demo(const DemoArgs& a, const Console& console) {
   std::printf("| --- | --- | --- | --- |\n");
   for (const Row& r : rows) {
     const std::string out = dir + "/poses_" + r.method + "_" + fs::path(r.map).stem().string() + ".txt";
-    relocalize({dir + "/camera.yaml", r.map, dir + "/query/detections.json", r.method, out, "", "", a.threads}, inner);
+    RelocalizeArgs args;
+    args.camera = dir + "/camera.yaml";
+    args.map = r.map;
+    args.detections = dir + "/query/detections.json";
+    args.method = r.method;
+    args.out = out;
+    args.threads = a.threads;
+    relocalize(args, inner);
     const Evaluation e = evaluate({dir + "/query/groundtruth.txt", out, dir + "/query/detections.json", ""});
     std::printf("| %s | %.1f | %.2f | %.1f |\n", r.name, e.median_position_cm, e.median_rotation_deg, e.validPercent());
     std::fflush(stdout);

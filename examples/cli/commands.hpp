@@ -32,6 +32,8 @@ void map(const MapArgs& a, const Console& console);
 
 struct RelocalizeArgs {
   std::string camera, map, detections, method = "ours", out, report, policy;
+  bool use_points = false;  ///< refine with the frames' keypoints matched to the map's points
+  std::string points;       ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;
 };
 /// Returns the number of frames relocalized.

@@ -60,6 +60,10 @@ int main(int argc, char** argv) {
   r->add_option("--policy", rl.policy, "observation policy (default: paper for ours, bbox for oa-slam)");
   r->add_option("--out", rl.out, "TUM poses of the relocalized frames")->required();
   r->add_option("--report", rl.report, "per-frame JSON report: status, inliers, score, time");
+  auto* points = r->add_option("--points", rl.points,
+                               "refine with keypoints matched to the map's points: from this file (same frame "
+                               "layout), or from the detections file when no file is given")
+                     ->expected(0, 1);
   r->add_option("--threads", rl.threads, "frames in parallel")->capture_default_str()->check(CLI::Range(1, 256));
   r->footer(
       "Example: ellreloc relocalize --camera camera.yaml --map map.json --detections keyframes.detections.json "
@@ -98,6 +102,7 @@ int main(int argc, char** argv) {
     if (s->parsed()) simulate(sim, console);
     if (o->parsed()) observe(obs, console);
     if (m->parsed()) map(mp, console);
+    rl.use_points = points->count() > 0;
     if (r->parsed()) relocalize(rl, console);
     if (e->parsed()) printEvaluation(evaluate(ev));
     if (d->parsed()) demo(dm, console);

@@ -228,6 +228,16 @@ ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, Relocal
     : map_(std::move(map)), K_(K), options_(std::move(options)) {}
 
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations) const {
+  return relocalize(observations, {});
+}
+
+RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations,
+                                                   const std::vector<Keypoint>& keypoints) const {
+  std::vector<PointMatch> points;
+  for (const Keypoint& k : keypoints)
+    if (k.point_index >= 0 && static_cast<size_t>(k.point_index) < map_.points.size() && k.uv.allFinite() &&
+        map_.points[static_cast<size_t>(k.point_index)].allFinite())
+      points.push_back({k.uv, map_.points[static_cast<size_t>(k.point_index)]});
   const auto start = std::chrono::steady_clock::now();
   RelocalizationResult result;
   const auto finish = [&](RelocalizationStatus status, std::string reason) {
@@ -343,7 +353,22 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
       result.refined = refined;
     }
   }
-  const double final_cost = scorer.cost(best, 128, &matches);
+  double final_cost = scorer.cost(best, 128, &matches);
+  // Points pull the chosen pose towards what the overlap measure cannot see; the result is
+  // kept when it still explains as many observations.
+  if (!points.empty() && options_.refine && !matches.empty()) {
+    std::vector<EllipseMatch> em;
+    for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
+    const RefinementResult r = refinePose(K_, best, em, points, options_.refiner);
+    std::vector<Match> with_points;
+    const double cost_with_points = r.fell_back ? 0.0 : scorer.cost(r.pose, 128, &with_points);
+    if (!r.fell_back && with_points.size() >= matches.size()) {
+      best = r.pose;
+      final_cost = cost_with_points;
+      matches = std::move(with_points);
+      result.refined = true;
+    }
+  }
   result.pose = best;
   result.cost = final_cost;
   double sum = 0.0;

@@ -80,6 +80,18 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
     EXPECT_NE(r.out.find("valid %"), std::string::npos);
     EXPECT_GT(fs::file_size(dir.path(method + ".png")), 1000u);
   }
+  // Keypoints matched to the map's points, from the detections file itself.
+  r = run("relocalize --camera " + s + "/camera.yaml --map " + s + "/map_perturbed.json --detections " + s +
+              "/query/detections.json --points --out " + dir.path("points.txt"),
+          dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(fs::file_size(dir.path("points.txt")), 0u);
+  r = run("relocalize --camera " + s + "/camera.yaml --map " + dir.path("map_voxel.json") + " --detections " + s +
+              "/query/detections.json --points --out " + dir.path("no_points.txt"),
+          dir);
+  EXPECT_EQ(r.code, 2);  // a voxel map has no points
+  EXPECT_NE(r.err.find("needs a map with `points`"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir.path("no_points.txt")));
   r = run("--help", dir);
   EXPECT_EQ(r.code, 0);
   for (const std::string sub : {"simulate", "observe", "map", "relocalize", "evaluate", "demo"}) {

@@ -18,6 +18,7 @@
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/object_map.hpp"
+#include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/observation.hpp"
 #include "ellreloc/pose/ransac.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
@@ -127,6 +128,13 @@ class ObjectRelocalizer {
   ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options = {});
 
   RelocalizationResult relocalize(const std::vector<Observation>& observations) const;
+  /// The same, with the frame's 2D feature matches to the map's points (the host SLAM system's
+  /// matcher output, outliers included): they join the Wasserstein refinement of the best
+  /// hypotheses ("objects + points", robust point loss). A refined pose is kept when it
+  /// explains at least as many observations as before. Keypoints whose index is outside
+  /// map().points or that are not finite are ignored.
+  RelocalizationResult relocalize(const std::vector<Observation>& observations,
+                                  const std::vector<Keypoint>& keypoints) const;
 
   const ObjectMap& map() const { return map_; }
   const Intrinsics& intrinsics() const { return K_; }
