@@ -212,29 +212,28 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     }
     used.push_back(j);
   }
-  // A track's expected box: its last box when seen in the last keyframes, else the projection
-  // of its ellipsoid (or of a sphere at its triangulated centre) into this keyframe.
+  // A track's expected box: the projection of its ellipsoid into this keyframe once it has
+  // one (it follows the camera's motion), else its last box when seen in the last keyframes,
+  // else the projection of a sphere at its triangulated centre.
   std::vector<size_t> candidates;
   std::vector<LabelledBox> object_boxes;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
     std::optional<Box> expected;
-    if (keyframes_ - t.last_seen <= options_.track_window) {
+    std::optional<Ellipsoid> e;
+    if (t.built) {
+      e = t.built->object.ellipsoid;
+    } else if (keyframes_ - t.last_seen <= options_.track_window) {
       expected = t.views.back().box;
-    } else {
-      std::optional<Ellipsoid> e;
-      if (t.built) {
-        e = t.built->object.ellipsoid;
-      } else if (const auto c = triangulateBoxCentres(K_, t.views)) {
-        const BoxView& last = t.views.back();
-        const double z = last.pose.transform(*c).z();
-        const double r = 0.25 * (last.box.width() / K_.fx + last.box.height() / K_.fy) * z;
-        if (r > 0.0) e = Ellipsoid(*c, Eigen::Vector3d::Constant(r), Eigen::Matrix3d::Identity());
-      }
-      if (e) {
-        const Projection p = project(*e, K_, pose);
-        if (p) expected = ellipseBox(p.ellipse);
-      }
+    } else if (const auto c = triangulateBoxCentres(K_, t.views)) {
+      const BoxView& last = t.views.back();
+      const double z = last.pose.transform(*c).z();
+      const double r = 0.25 * (last.box.width() / K_.fx + last.box.height() / K_.fy) * z;
+      if (r > 0.0) e = Ellipsoid(*c, Eigen::Vector3d::Constant(r), Eigen::Matrix3d::Identity());
+    }
+    if (e) {
+      const Projection p = project(*e, K_, pose);
+      if (p) expected = ellipseBox(p.ellipse);
     }
     if (!expected) continue;
     candidates.push_back(i);
@@ -258,6 +257,29 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     }
     t->views.push_back({pose, d.bbox});
     observed(*t, d);
+  }
+  mergeDuplicateBoxTracks();
+}
+
+void Mapper::mergeDuplicateBoxTracks() {
+  // Box tracking breaks when a small object moves more than its size between keyframes; the
+  // pieces then give nearly the same ellipsoid. Two built objects of one label whose centres
+  // lie within the smaller one's mean semi-axis are one object: the younger joins the older.
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    for (size_t j = i + 1; j < tracks_.size(); ++j) {
+      Track &a = tracks_[i], &b = tracks_[j];
+      if (!a.built || !b.built || a.label() != b.label()) continue;
+      const Ellipsoid &ea = a.built->object.ellipsoid, &eb = b.built->object.ellipsoid;
+      const double reach = std::min(ea.axes().mean(), eb.axes().mean());
+      if ((ea.center() - eb.center()).norm() > reach) continue;
+      a.views.insert(a.views.end(), b.views.begin(), b.views.end());
+      for (const auto& [category, weight] : b.labels) a.labels[category] += weight;
+      a.observations += b.observations;
+      a.last_seen = std::max(a.last_seen, b.last_seen);
+      rebuild(a);
+      tracks_.erase(tracks_.begin() + static_cast<long>(j));
+      --j;
+    }
   }
 }
 

@@ -123,6 +123,7 @@ class Mapper {
                         KeyframeReport* report);
   void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report);
   void observed(Track& track, const Detection& detection);
+  void mergeDuplicateBoxTracks();
   void rebuild(Track& track) const;
 
   Intrinsics K_;
