@@ -1,13 +1,13 @@
 #include "ellreloc/io/camera.hpp"
 
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 #include "json_fields.hpp"
-
-#include <opencv2/core.hpp>
-
-#include <cmath>
-#include <sstream>
 
 namespace ellreloc::io {
 
@@ -36,17 +36,46 @@ Intrinsics readJson(const std::string& path) {
   return K;
 }
 
-double yamlNumber(const cv::FileStorage& fs, const std::string& key, const std::string& path) {
-  const cv::FileNode node = fs[key];
-  if (node.empty() || node.isNone()) throw Error(path + ": " + key + ": missing");
-  if (!node.isReal() && !node.isInt()) throw Error(path + ": " + key + ": expected a number");
-  const double v = node.real();
+/// The top-level `key: value` lines of an ORB-SLAM style YAML file. OpenCV's FileStorage is
+/// not used: it aborts the process on some malformed documents (found by fuzzing). Indented
+/// lines (nested maps, matrices), comments, directives and document markers are skipped.
+std::map<std::string, std::string> yamlTopLevel(const std::string& text, const std::string& path) {
+  std::map<std::string, std::string> values;
+  int line_number = 0;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == ' ' || line[0] == '\t' || line[0] == '#' || line[0] == '%' ||
+        line.rfind("---", 0) == 0 || line.rfind("...", 0) == 0)
+      continue;
+    const size_t colon = line.find(':');
+    if (colon == std::string::npos)
+      throw Error(path + ": line " + std::to_string(line_number) + ": expected key: value");
+    const std::string key = line.substr(0, colon);
+    std::string value = line.substr(colon + 1);
+    if (const size_t hash = value.find(" #"); hash != std::string::npos) value.resize(hash);
+    const size_t first = value.find_first_not_of(" \t"), last = value.find_last_not_of(" \t");
+    value = first == std::string::npos ? "" : value.substr(first, last - first + 1);
+    if (!values.emplace(key, value).second)
+      throw Error(path + ": line " + std::to_string(line_number) + ": " + key + " given twice");
+  }
+  return values;
+}
+
+double yamlNumber(const std::map<std::string, std::string>& values, const std::string& key, const std::string& path) {
+  const auto it = values.find(key);
+  if (it == values.end() || it->second.empty()) throw Error(path + ": " + key + ": missing");
+  const char* begin = it->second.c_str();
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (end == begin || *end != '\0') throw Error(path + ": " + key + ": expected a number");
   if (!std::isfinite(v)) throw Error(path + ": " + key + ": not a finite number");
   return v;
 }
 
-int yamlInteger(const cv::FileStorage& fs, const std::string& key, const std::string& path) {
-  const double v = yamlNumber(fs, key, path);
+int yamlInteger(const std::map<std::string, std::string>& values, const std::string& key, const std::string& path) {
+  const double v = yamlNumber(values, key, path);
   if (v != std::floor(v) || std::abs(v) > 1e9) throw Error(path + ": " + key + ": expected an integer");
   return static_cast<int>(v);
 }
@@ -54,22 +83,14 @@ int yamlInteger(const cv::FileStorage& fs, const std::string& key, const std::st
 Intrinsics readYaml(const std::string& path) {
   const std::string text = readTextFile(path);  // names the file if it does not exist
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error(path + ": empty file, expected a camera");
-  cv::FileStorage fs;
-  try {
-    // OpenCV's YAML parser wants the %YAML header; ORB-SLAM files have it, hand-written ones may not.
-    const std::string content = text.rfind("%YAML", 0) == 0 ? text : "%YAML:1.0\n" + text;
-    fs.open(content, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    throw Error(path + ": invalid YAML (" + e.msg + ")");
-  }
-  if (!fs.isOpened()) throw Error(path + ": invalid YAML");
+  const std::map<std::string, std::string> values = yamlTopLevel(text, path);
   Intrinsics K;
-  K.fx = yamlNumber(fs, "Camera.fx", path);
-  K.fy = yamlNumber(fs, "Camera.fy", path);
-  K.cx = yamlNumber(fs, "Camera.cx", path);
-  K.cy = yamlNumber(fs, "Camera.cy", path);
-  K.width = yamlInteger(fs, "Camera.width", path);
-  K.height = yamlInteger(fs, "Camera.height", path);
+  K.fx = yamlNumber(values, "Camera.fx", path);
+  K.fy = yamlNumber(values, "Camera.fy", path);
+  K.cx = yamlNumber(values, "Camera.cx", path);
+  K.cy = yamlNumber(values, "Camera.cy", path);
+  K.width = yamlInteger(values, "Camera.width", path);
+  K.height = yamlInteger(values, "Camera.height", path);
   return K;
 }
 

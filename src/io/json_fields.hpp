@@ -18,7 +18,7 @@ inline json parseJson(const std::string& text, const std::string& file) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error(file + ": empty file, expected JSON");
   try {
     return json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax errors, and numbers too large for a double
     throw Error(file + ": invalid JSON (" + std::string(e.what()) + ")");
   }
 }

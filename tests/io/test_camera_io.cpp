@@ -1,11 +1,10 @@
+#include <gtest/gtest.h>
+
+#include "../data_dir.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/files.hpp"
-
-#include "../data_dir.hpp"
 #include "temp_dir.hpp"
-
-#include <gtest/gtest.h>
 
 using namespace ellreloc;
 
@@ -43,14 +42,30 @@ TEST(CameraIo, MalformedFilesNameTheFileAndKey) {
       {"empty.json", "", "empty file"},
       {"trunc.json", "{\"fx\": 500, \"fy\":", "invalid JSON"},
       {"missing.json", "{\"fx\": 500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640}", "height: missing"},
-      {"type.json", "{\"fx\": \"500\", \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640, \"height\": 480}", "fx: expected a number"},
-      {"neg.json", "{\"fx\": -500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640, \"height\": 480}", "positive"},
+      {"type.json", "{\"fx\": \"500\", \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640, \"height\": 480}",
+       "fx: expected a number"},
+      {"neg.json", "{\"fx\": -500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640, \"height\": 480}",
+       "positive"},
       {"zero.json", "{\"fx\": 500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 0, \"height\": 480}", "positive"},
-      {"frac.json", "{\"fx\": 500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640.5, \"height\": 480}", "width: expected an integer"},
+      {"frac.json", "{\"fx\": 500, \"fy\": 500, \"cx\": 320, \"cy\": 240, \"width\": 640.5, \"height\": 480}",
+       "width: expected an integer"},
       {"array.json", "[1, 2, 3]", "expected an object"},
       {"empty.yaml", "  \n", "empty file"},
-      {"missing.yaml", "%YAML:1.0\nCamera.fx: 500\nCamera.fy: 500\nCamera.cx: 320\nCamera.width: 640\nCamera.height: 480\n", "Camera.cy: missing"},
-      {"text.yaml", "%YAML:1.0\nCamera.fx: abc\nCamera.fy: 500\nCamera.cx: 320\nCamera.cy: 2\nCamera.width: 640\nCamera.height: 480\n", "Camera.fx"},
+      {"missing.yaml",
+       "%YAML:1.0\nCamera.fx: 500\nCamera.fy: 500\nCamera.cx: 320\nCamera.width: 640\nCamera.height: 480\n",
+       "Camera.cy: missing"},
+      {"text.yaml",
+       "%YAML:1.0\nCamera.fx: abc\nCamera.fy: 500\nCamera.cx: 320\nCamera.cy: 2\nCamera.width: 640\nCamera.height: "
+       "480\n",
+       "Camera.fx"},
+      {"twice.yaml", "Camera.fx: 500\nCamera.fx: 501\n", "line 2: Camera.fx given twice"},
+      {"nocolon.yaml", "Camera.fx 500\n", "line 1: expected key: value"},
+      {"trailing.yaml",
+       "Camera.fx: 500px\nCamera.fy: 500\nCamera.cx: 320\nCamera.cy: 2\nCamera.width: 640\nCamera.height: 480\n",
+       "Camera.fx: expected a number"},
+      // Found by fuzzing: deep nesting made OpenCV's YAML parser abort the process.
+      {"nested.yaml", "{\"fx\": 525.0, :y\"f \"525.1[[[[[[[[[[[[[[[[[[[[[[[[[[[[0, \"cxfx\":. 319",
+       "Camera.fx: missing"},
   };
   for (const Case& c : cases) {
     io::writeFileAtomically(dir.path(c.name), c.content);
@@ -65,5 +80,13 @@ TEST(CameraIo, MalformedFilesNameTheFileAndKey) {
     }
   }
   EXPECT_THROW(io::readCamera(dir.path("does-not-exist.yaml")), Error);
+  // Nested maps and matrices of other keys (indented) are skipped; comments after values too.
+  io::writeFileAtomically(dir.path("nested_ok.yaml"),
+                          "%YAML:1.0\n---\nCamera.fx: 500 # focal\nCamera.fy: 501\nCamera.cx: 320\nCamera.cy: 240\n"
+                          "Camera.width: 640\nCamera.height: 480\nTbc: !!opencv-matrix\n  rows: 4\n  data: [1, 0]\n");
+  const Intrinsics K = io::readCamera(dir.path("nested_ok.yaml"));
+  EXPECT_EQ(K.fx, 500.0);
+  EXPECT_EQ(K.fy, 501.0);
+  EXPECT_EQ(K.height, 480);
   EXPECT_THROW(io::readCamera(dir.path("")), Error);  // a directory
 }

@@ -128,6 +128,32 @@ TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
             RelocalizationStatus::NotEnoughObservations);
 }
 
+// A host process must be able to bound the work: 200 objects of one category and 50
+// observations are 1.3e11 triplet pairs; the hypothesis and time budgets stop the search.
+TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
+  std::mt19937 rng(91);
+  const Intrinsics K = test::testIntrinsics();
+  Synthetic s = makeScene(rng, 200, 1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  while (s.observations.size() < 50) {  // pad with clutter of the same category
+    Observation o = s.observations[0];
+    o.ellipse = Ellipse({640 * u(rng), 480 * u(rng)}, {5 + 40 * u(rng), 5 + 20 * u(rng)}, u(rng));
+    s.observations.push_back(o);
+  }
+  s.observations.resize(50);
+  RelocalizerOptions hypotheses_only;
+  hypotheses_only.ransac.max_hypotheses = 300;
+  const RelocalizationResult a = ObjectRelocalizer(s.map, K, hypotheses_only).relocalize(s.observations);
+  EXPECT_LE(a.hypotheses, 300 + 4);  // the last triplet's P3P solutions may finish
+  EXPECT_TRUE(a.budget_exhausted);
+  RelocalizerOptions time_only;
+  time_only.ransac.max_hypotheses = 1L << 40;
+  time_only.ransac.max_time_ms = 1.0;
+  const RelocalizationResult b = ObjectRelocalizer(s.map, K, time_only).relocalize(s.observations);
+  EXPECT_TRUE(b.budget_exhausted);  // stopped by the clock, not by running out of triplets
+  EXPECT_LT(b.hypotheses, 1L << 30);
+}
+
 TEST(ObjectRelocalizer, DeterministicAndThreadSafe) {
   std::mt19937 rng(84);
   const Intrinsics K = test::testIntrinsics();

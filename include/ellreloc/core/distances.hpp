@@ -84,7 +84,8 @@ void wasserstein2Residual(const Vec2<T>& m1, const Mat2<T>& S1, const Vec2<T>& m
 
 inline double wasserstein2Squared(const Ellipse& a, const Ellipse& b) {
   if (!a.isValid() || !b.isValid()) return std::numeric_limits<double>::infinity();
-  return wasserstein2Squared<double>(a.center(), a.covariance(), b.center(), b.covariance());
+  const double d = wasserstein2Squared<double>(a.center(), a.covariance(), b.center(), b.covariance());
+  return std::isnan(d) ? std::numeric_limits<double>::infinity() : d;  // overflow of absurd sizes: far apart
 }
 
 /// Wasserstein-2 distance in pixels.
@@ -102,7 +103,7 @@ inline double bhattacharyya(const Ellipse& a, const Ellipse& b) {
   const double det = S.determinant();
   if (!(det > 0.0)) return std::numeric_limits<double>::infinity();
   const double result = 0.125 * d.dot(S.inverse() * d) + 0.5 * (std::log(det) - 0.5 * (ln_det1 + ln_det2));
-  return std::max(0.0, result);
+  return std::isnan(result) ? std::numeric_limits<double>::infinity() : std::max(0.0, result);
 }
 
 namespace detail {
@@ -230,7 +231,8 @@ T levelSetDistance(const Vec2<T>& c1, const Mat2<T>& S1, const Vec2<T>& c2, cons
 
 inline double levelSetDistance(const Ellipse& a, const Ellipse& b, int samples_per_level = 16) {
   if (!a.isValid() || !b.isValid() || samples_per_level < 1) return std::numeric_limits<double>::infinity();
-  return levelSetDistance<double>(a.center(), a.covariance(), b.center(), b.covariance(), samples_per_level);
+  const double d = levelSetDistance<double>(a.center(), a.covariance(), b.center(), b.covariance(), samples_per_level);
+  return std::isnan(d) ? std::numeric_limits<double>::infinity() : d;
 }
 
 }  // namespace ellreloc

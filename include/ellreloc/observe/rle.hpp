@@ -79,19 +79,22 @@ inline std::optional<std::vector<uint32_t>> decodeRleString(const std::string& s
   std::vector<uint32_t> counts;
   size_t p = 0;
   while (p < s.size()) {
-    long long x = 0;
+    // Groups of 5 bits, least significant first; 8 groups (40 bits) hold any 32-bit run and
+    // its difference, so longer groups are malformed (and would overflow the shifts).
+    uint64_t bits = 0;
     int k = 0;
     bool more = true;
     while (more) {
-      if (p >= s.size() || k > 12) return std::nullopt;  // truncated or absurdly long group
+      if (p >= s.size() || k >= 8) return std::nullopt;  // truncated or absurdly long group
       const int c = static_cast<unsigned char>(s[p]) - 48;
       if (c < 0 || c > 63) return std::nullopt;
-      x |= static_cast<long long>(c & 0x1f) << (5 * k);
+      bits |= static_cast<uint64_t>(c & 0x1f) << (5 * k);
       more = (c & 0x20) != 0;
       ++p;
       ++k;
-      if (!more && (c & 0x10)) x |= -(1LL << (5 * k));  // sign-extend
+      if (!more && (c & 0x10)) bits |= ~uint64_t{0} << (5 * k);  // sign-extend
     }
+    long long x = static_cast<long long>(bits);
     if (counts.size() > 2) x += counts[counts.size() - 2];
     if (x < 0 || x > 0xffffffffLL) return std::nullopt;
     counts.push_back(static_cast<uint32_t>(x));

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang-14 (ASan + UBSan, errors abort) into build-fuzz/ and
+# runs each for SECONDS (default 30) from the seed corpus in tests/fuzz/corpus. The corpus grown
+# during the run stays in build-fuzz/corpus/; crashing inputs go to build-fuzz/artifacts/.
+#   scripts/fuzz.sh [SECONDS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-30}"
+dir="${ELLRELOC_FUZZ_DIR:-build-fuzz}"
+CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DELLRELOC_BUILD_FUZZERS=ON -DELLRELOC_BUILD_TESTS=OFF -DELLRELOC_BUILD_BENCHMARKS=OFF \
+  -DELLRELOC_BUILD_EXAMPLES=OFF \
+  -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" >/dev/null
+cmake --build "$dir" -j "$(nproc)"
+mkdir -p "$dir/artifacts"
+status=0
+for target in fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer; do
+  mkdir -p "$dir/corpus/$target"
+  log="$dir/$target.log"
+  if "$dir/tests/fuzz/$target" "$dir/corpus/$target" "tests/fuzz/corpus/$target" \
+      -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -print_final_stats=1 \
+      -artifact_prefix="$dir/artifacts/$target-" >"$log" 2>&1; then
+    runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
+    echo "fuzz: $target ok, $runs executions in ${seconds} s"
+  else
+    echo "fuzz: $target FAILED (input in $dir/artifacts/); last lines of $log:" >&2
+    tail -n 30 "$log" >&2
+    status=1
+  fi
+done
+exit $status

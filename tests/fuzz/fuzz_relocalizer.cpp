@@ -1,0 +1,38 @@
+// The relocalizer with a small map and observations built from the fuzzer's numbers: a
+// status, never a crash, and a successful pose is a valid rigid transform.
+#include "ellreloc/pose/object_relocalizer.hpp"
+#include "fuzz_input.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace ellreloc;
+  fuzz::Input in(data, size);
+  const bool raw = in.small(4) == 0;
+  const auto num = [&](double lo, double hi) { return raw ? in.real() : in.scaled(lo, hi); };
+  ObjectMap map;
+  const int objects = 1 + in.small(8);
+  for (int i = 0; i < objects; ++i) {
+    MapObject o;
+    o.id = i;
+    o.category = in.small(3);
+    o.ellipsoid = Ellipsoid({num(-2, 2), num(-2, 2), num(0, 1)}, {num(0.01, 0.5), num(0.01, 0.5), num(0.01, 0.5)},
+                            Eigen::AngleAxisd(num(-4, 4), Eigen::Vector3d::UnitZ()).toRotationMatrix());
+    map.objects.push_back(o);
+  }
+  std::vector<Observation> observations;
+  const int n = in.small(10);
+  for (int i = 0; i < n; ++i) {
+    Observation o;
+    o.category = in.small(3);
+    o.score = num(0, 1);
+    o.ellipse = Ellipse({num(0, 640), num(0, 480)}, {num(1, 200), num(1, 200)}, num(-2, 2));
+    o.box = o.ellipse.boundingBox();
+    observations.push_back(o);
+  }
+  RelocalizerOptions options;
+  options.ransac.max_hypotheses = 2000;  // keep each run short
+  const ObjectRelocalizer relocalizer(map, Intrinsics(525, 525, 319.5, 239.5, 640, 480), options);
+  const RelocalizationResult r = relocalizer.relocalize(observations);
+  FUZZ_CHECK(r.status != RelocalizationStatus::Success || r.pose.isValid());
+  FUZZ_CHECK(r.hypotheses <= options.ransac.max_hypotheses + 64);  // the budget holds
+  return 0;
+}
