@@ -286,6 +286,13 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   const Scorer scorer(observations, valid, candidates, map_, K_, options_);
   const PairEstimator estimator{pairs, observations, map_, K_, options_, scorer, {}};
   RansacOptions ropt = options_.ransac;
+  // Scoring a hypothesis costs up to (map objects) x (usable observations) overlaps: a large
+  // map with many observations gets fewer hypotheses, so that the worst case stays bounded.
+  if (options_.max_overlap_evaluations > 0) {
+    const double per_hypothesis = static_cast<double>(map_.objects.size()) * static_cast<double>(usable);
+    const long affordable = static_cast<long>(static_cast<double>(options_.max_overlap_evaluations) / per_hypothesis);
+    ropt.max_hypotheses = std::min(ropt.max_hypotheses, std::max(affordable, options_.min_hypotheses_budget));
+  }
   const int n = static_cast<int>(pairs.size());
   HypothesisSampler sampler = options_.sampler;
   if (sampler == HypothesisSampler::Auto) {

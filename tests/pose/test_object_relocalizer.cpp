@@ -146,7 +146,14 @@ TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
   const RelocalizationResult a = ObjectRelocalizer(s.map, K, hypotheses_only).relocalize(s.observations);
   EXPECT_LE(a.hypotheses, 300 + 4);  // the last triplet's P3P solutions may finish
   EXPECT_TRUE(a.budget_exhausted);
+  RelocalizerOptions work_only;  // the machine-independent bound: 3e6 overlaps = 300 hypotheses here
+  work_only.max_overlap_evaluations = 200L * 50 * 300;
+  work_only.min_hypotheses_budget = 10;
+  const RelocalizationResult w = ObjectRelocalizer(s.map, K, work_only).relocalize(s.observations);
+  EXPECT_LE(w.hypotheses, 300 + 4);
+  EXPECT_TRUE(w.budget_exhausted);
   RelocalizerOptions time_only;
+  time_only.max_overlap_evaluations = 0;
   time_only.ransac.max_hypotheses = 1L << 40;
   time_only.ransac.max_time_ms = 1.0;
   const RelocalizationResult b = ObjectRelocalizer(s.map, K, time_only).relocalize(s.observations);

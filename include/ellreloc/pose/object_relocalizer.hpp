@@ -61,6 +61,12 @@ struct RelocalizerOptions {
   bool refine = true;
   RefinerOptions refiner;
   RansacOptions ransac;  ///< budgets, adaptive stopping, seed
+  /// A machine-independent bound on the work: the hypothesis budget shrinks to this many
+  /// overlaps over (map objects x usable observations), but not below min_hypotheses_budget.
+  /// 40e6 leaves the 50,000 hypotheses untouched up to 800 object-observation pairs (47
+  /// objects x 17 observations) and gives 4,000 for 200 objects x 50 observations. 0: no bound.
+  long max_overlap_evaluations = 40000000;
+  long min_hypotheses_budget = 1000;
 
   RelocalizerOptions() {
     ransac.min_iterations = 50;
@@ -88,6 +94,7 @@ struct RelocalizerOptions {
     o.ransac.max_iterations = 1 << 30;
     o.ransac.max_hypotheses = 1L << 40;
     o.ransac.max_time_ms = 0.0;
+    o.max_overlap_evaluations = 0;  // the baseline enumerates everything
     return o;
   }
 };
