@@ -66,6 +66,36 @@ void BM_Relocalize47x12(benchmark::State& state) {
 }
 BENCHMARK(BM_Relocalize47x12)->ArgName("oaslam")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
+/// The worst case a host must survive: 200 objects of one category, 50 observations (the visible
+/// objects and clutter), default options: the work bound limits the search (docs/reliability.md).
+void BM_RelocalizeWorstCase200x50(benchmark::State& state) {
+  const Room room = makeRoom(200, 1, 20, 5);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::vector<Observation>> queries;
+  for (const Pose& p : room.cameras) {
+    auto obs = observe(room, p, 50, rng);
+    while (obs.size() < 50) {  // clutter of the same category
+      Observation o;
+      o.category = 0;
+      o.ellipse = Ellipse({640 * u(rng), 480 * u(rng)}, {5 + 40 * u(rng), 5 + 20 * u(rng)}, u(rng));
+      o.box = o.ellipse.boundingBox();
+      obs.push_back(o);
+    }
+    queries.push_back(obs);
+  }
+  const ObjectRelocalizer reloc(room.map, kK);
+  size_t i = 0;
+  double hypotheses = 0;
+  for (auto _ : state) {
+    const RelocalizationResult r = reloc.relocalize(queries[i]);
+    hypotheses = static_cast<double>(r.hypotheses);
+    i = (i + 1) % queries.size();
+  }
+  state.counters["hypotheses"] = hypotheses;
+}
+BENCHMARK(BM_RelocalizeWorstCase200x50)->Iterations(5)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -7,10 +7,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 dir="${ELLRELOC_FUZZ_DIR:-build-fuzz}"
-CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE= \
   -DELLRELOC_BUILD_FUZZERS=ON -DELLRELOC_BUILD_TESTS=OFF -DELLRELOC_BUILD_BENCHMARKS=OFF \
   -DELLRELOC_BUILD_EXAMPLES=OFF \
-  -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" >/dev/null
+  -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" >/dev/null
 cmake --build "$dir" -j "$(nproc)"
 mkdir -p "$dir/artifacts"
 status=0

@@ -129,7 +129,7 @@ TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
 }
 
 // A host process must be able to bound the work: 200 objects of one category and 50
-// observations are 1.3e11 triplet pairs; the hypothesis and time budgets stop the search.
+// observations are about 1.7e11 triplets of pairs; the hypothesis and time budgets stop the search.
 TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
   std::mt19937 rng(91);
   const Intrinsics K = test::testIntrinsics();
