@@ -1,17 +1,20 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets with clang-14 (ASan + UBSan, errors abort) into build-fuzz/ and
-# runs each for SECONDS (default 30) from the seed corpus in tests/fuzz/corpus. The corpus grown
-# during the run stays in build-fuzz/corpus/; crashing inputs go to build-fuzz/artifacts/.
+# Runs each libFuzzer target (ASan + UBSan, any report aborts) for SECONDS (default 30) from the
+# seed corpus in tests/fuzz/corpus. The targets come from the sanitizer build of
+# scripts/sanitize.sh asan (built here if missing). The corpus grown during the run stays in
+# build-asan/corpus/; crashing inputs go to build-asan/artifacts/.
 #   scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-30}"
-dir="${ELLRELOC_FUZZ_DIR:-build-fuzz}"
-CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE= \
-  -DELLRELOC_BUILD_FUZZERS=ON -DELLRELOC_BUILD_TESTS=OFF -DELLRELOC_BUILD_BENCHMARKS=OFF \
-  -DELLRELOC_BUILD_EXAMPLES=OFF \
-  -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all" >/dev/null
-cmake --build "$dir" -j "$(nproc)"
+dir=build-asan
+if [ ! -x "$dir/tests/fuzz/fuzz_rle" ]; then
+  CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE= -DELLRELOC_BUILD_BENCHMARKS=OFF \
+    -DELLRELOC_BUILD_FUZZERS=ON \
+    -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+    >/dev/null
+  cmake --build "$dir" -j "$(nproc)" --target fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer
+fi
 mkdir -p "$dir/artifacts"
 status=0
 for target in fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer; do

@@ -7,7 +7,7 @@ packages=(
   libeigen3-dev libceres-dev libopencv-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopengv-dev  # benchmarks only: P3P comparison with OpenGV's Kneip solver
-  clang-14 libclang-rt-14-dev  # reliability only: libFuzzer targets (scripts/fuzz.sh)
+  clang-14 libclang-rt-14-dev  # reliability only: sanitizer builds and libFuzzer (scripts/sanitize.sh, fuzz.sh)
 )
 
 missing=()

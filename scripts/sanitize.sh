@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer (errors abort), in
-# build-asan/, then the concurrency tests under ThreadSanitizer, in build-tsan/.
+# Sanitizer runs (docs/reliability.md), with clang-14:
+#   asan: the whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer (any report
+#         aborts), in build-asan/. The same build holds the libFuzzer targets (scripts/fuzz.sh
+#         uses it), so one instrumented build serves both.
+#   tsan: the concurrency tests under ThreadSanitizer, in build-tsan/.
 #   scripts/sanitize.sh [asan|tsan|all]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -8,10 +11,11 @@ what="${1:-all}"
 jobs="$(nproc)"
 # -O1 without debug info: sanitizer builds compile several times slower than release ones.
 common=(-G Ninja -DCMAKE_BUILD_TYPE= -DELLRELOC_BUILD_BENCHMARKS=OFF)
+export CC=clang-14 CXX=clang++-14
 
 if [ "$what" = asan ] || [ "$what" = all ]; then
-  cmake -S . -B build-asan "${common[@]}" \
-    -DCMAKE_CXX_FLAGS="-O1 -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" \
+  cmake -S . -B build-asan "${common[@]}" -DELLRELOC_BUILD_FUZZERS=ON \
+    -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer" \
     >/dev/null
   cmake --build build-asan -j "$jobs"
   # The packaging test installs and rebuilds the examples: nothing to sanitize there.

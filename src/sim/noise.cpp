@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "draw.hpp"
 #include "ellreloc/observe/mask.hpp"
 
 namespace ellreloc::sim {
@@ -90,7 +91,8 @@ RleMask flipPixels(const RleMask& rle, double rate, std::mt19937_64& rng) {
   const int y2 = std::min(m->height - 1, static_cast<int>(moments->bounds.y2 - 0.5) + 2);
   std::uniform_int_distribution<int> ux(x1, x2), uy(y1, y2);
   for (long k = std::lround(rate * moments->area); k > 0; --k) {
-    uint8_t& px = m->at(ux(rng), uy(rng));
+    const int y = uy(rng);  // drawn before x: see drawLastFirst
+    uint8_t& px = m->at(ux(rng), y);
     px = px ? 0 : 1;
   }
   return encodeMask(*m);
@@ -116,9 +118,8 @@ std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, co
     const auto moments = rleMoments(*d.mask);
     if (!moments) continue;  // eroded away
     const Box& b = moments->bounds;
-    d.bbox = Box(b.x1 + noise.box_jitter_px * g(rng), b.y1 + noise.box_jitter_px * g(rng),
-                 b.x2 + noise.box_jitter_px * g(rng), b.y2 + noise.box_jitter_px * g(rng))
-                 .intersection(image);
+    const Eigen::Vector4d jitter = detail::drawLastFirst<4>([&] { return noise.box_jitter_px * g(rng); });
+    d.bbox = Box(b.x1 + jitter(0), b.y1 + jitter(1), b.x2 + jitter(2), b.y2 + jitter(3)).intersection(image);
     if (!(d.bbox.width() > 2) || !(d.bbox.height() > 2)) continue;
     d.object_id = scene.objects[j].id;
     out.push_back(std::move(d));
@@ -161,7 +162,7 @@ std::vector<Keypoint> keypoints(const Scene& scene, const RenderedFrame& frame, 
     if (z > 0 && x(2) > z + 0.03) continue;  // hidden behind another surface
     Keypoint k;
     k.point_index = i;
-    k.uv = uv + noise.keypoint_sigma_px * Eigen::Vector2d(g(rng), g(rng));
+    k.uv = uv + noise.keypoint_sigma_px * detail::drawLastFirst<2>([&] { return g(rng); });
     if (u(rng) < noise.keypoint_outliers) k.point_index = static_cast<int>(u(rng) * n) % n;  // a wrong match
     out.push_back(k);
   }
@@ -187,7 +188,7 @@ ObjectMap perturbMap(const ObjectMap& map, const NoiseModel& noise, uint64_t see
   ObjectMap out = map;
   for (MapObject& o : out.objects) {
     const Ellipsoid& e = o.ellipsoid;
-    const Eigen::Vector3d c = e.center() + noise.map_centre_sigma * Eigen::Vector3d(g(rng), g(rng), g(rng));
+    const Eigen::Vector3d c = e.center() + noise.map_centre_sigma * detail::drawLastFirst<3>([&] { return g(rng); });
     Eigen::Vector3d axes = e.axes();
     for (int k = 0; k < 3; ++k) axes(k) *= std::max(0.3, 1.0 + noise.map_axis_sigma * g(rng));
     const Eigen::Matrix3d R =

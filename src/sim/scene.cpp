@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "draw.hpp"
+
 namespace ellreloc::sim {
 
 namespace {
@@ -42,7 +44,7 @@ Primitive box(const Eigen::Vector3d& c, const Eigen::Vector3d& half, const Eigen
 /// its size scaled by s per axis (0.8-1.2).
 SimObject makeObject(int id, const Category& cat, double x, double y, double z, double a, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> s(0.85, 1.15);
-  const Eigen::Vector3d half = cat.half.cwiseProduct(Eigen::Vector3d(s(rng), s(rng), s(rng)));
+  const Eigen::Vector3d half = cat.half.cwiseProduct(detail::drawLastFirst<3>([&] { return s(rng); }));
   const Eigen::Matrix3d R = yaw(a);
   SimObject o;
   o.id = id;
@@ -93,15 +95,15 @@ Eigen::Vector3d surfacePoint(const Primitive& p, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::Vector3d l;
   if (p.shape == PrimitiveShape::Box) {
-    l = Eigen::Vector3d(u(rng), u(rng), u(rng));
+    l = detail::drawLastFirst<3>([&] { return u(rng); });
     const int face = static_cast<int>((u(rng) + 1.0) * 1.5) % 3;
     l(face) = l(face) >= 0 ? 1.0 : -1.0;
     l = l.cwiseProduct(p.half);
   } else if (p.shape == PrimitiveShape::Cylinder) {
     const double a = M_PI * u(rng);
-    l = Eigen::Vector3d(p.half(0) * std::cos(a), p.half(0) * std::sin(a), p.half(2) * u(rng));
+    l = Eigen::Vector3d(p.half(0) * std::cos(a), p.half(0) * std::sin(a), p.half(2) * u(rng));  // one draw
   } else {
-    l = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized().cwiseProduct(p.half);
+    l = detail::drawLastFirst<3>([&] { return u(rng); }).normalized().cwiseProduct(p.half);
   }
   return p.center + p.rotation * l;
 }
@@ -153,7 +155,8 @@ Scene makeScene(ScenePreset preset, uint64_t seed) {
     const double a = 2.0 * M_PI * t / n_tables + 0.4 * u(rng);
     const double r = 0.9 + 0.3 * u(rng);
     const double height = t == 2 ? 1.1 : 0.75;
-    const Eigen::Vector2d half(0.6 + 0.2 * u(rng), 0.35 + 0.1 * u(rng));
+    const double half_y = 0.35 + 0.1 * u(rng);  // drawn before x: see drawLastFirst
+    const Eigen::Vector2d half(0.6 + 0.2 * u(rng), half_y);
     const double ty = a + M_PI / 2;
     surfaces.push_back({Eigen::Vector3d(r * std::cos(a), r * std::sin(a), height), half, ty});
     scene.furniture.push_back({PrimitiveShape::Box, Eigen::Vector3d(r * std::cos(a), r * std::sin(a), height - 0.02),
@@ -184,7 +187,8 @@ Scene makeScene(ScenePreset preset, uint64_t seed) {
       x = r * std::cos(ang), y = r * std::sin(ang), z = 0.0, a = 2 * M_PI * u(rng);
     } else {
       const Surface& s = surfaces[static_cast<size_t>(u(rng) * surfaces.size()) % surfaces.size()];
-      const Eigen::Vector3d local((2 * u(rng) - 1) * (s.half(0) - 0.1), (2 * u(rng) - 1) * (s.half(1) - 0.08), 0);
+      const double local_y = (2 * u(rng) - 1) * (s.half(1) - 0.08);  // drawn before x: see drawLastFirst
+      const Eigen::Vector3d local((2 * u(rng) - 1) * (s.half(0) - 0.1), local_y, 0);
       const Eigen::Vector3d w = s.center + yaw(s.yaw) * local;
       // TVs and laptops face the room's centre roughly; others any way.
       x = w(0), y = w(1), z = s.center(2);
@@ -235,7 +239,8 @@ std::vector<Pose> queryTrajectory(const Scene& scene, int frames, uint64_t seed)
     const double a = 2.0 * M_PI * u(rng);
     const double r = 1.5 + (r_max - 1.5) * u(rng);
     const double h = 0.8 + 1.2 * u(rng);
-    const Eigen::Vector3d target(0.5 * (u(rng) - 0.5), 0.5 * (u(rng) - 0.5), 0.3 + 0.6 * u(rng));
+    const Eigen::Vector3d draws = detail::drawLastFirst<3>([&] { return u(rng); });
+    const Eigen::Vector3d target(0.5 * (draws(0) - 0.5), 0.5 * (draws(1) - 0.5), 0.3 + 0.6 * draws(2));
     poses.push_back(Pose::lookAt(Eigen::Vector3d(r * std::cos(a), r * std::sin(a), h), target));
   }
   return poses;
