@@ -8,6 +8,8 @@
 /// ellipsoid's projection (Ceres). Objects whose projections keep overlapping their boxes
 /// poorly are rejected.
 
+#include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 

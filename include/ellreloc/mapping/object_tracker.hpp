@@ -12,6 +12,7 @@
 ///     n(v, v_i) > xi min(|v|, |v_i|)  and  n(v_i, v) > xi min(|v|, |v_i|),
 /// n(a, b) = voxels of a with a voxel of b within radius r.
 
+#include <algorithm>
 #include <vector>
 
 #include "ellreloc/core/box.hpp"
