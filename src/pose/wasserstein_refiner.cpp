@@ -40,6 +40,13 @@ void loss(RobustLoss type, double c, double s, double* rho, double* drho) {
   }
 }
 
+/// A gravity prior with unit directions and sigma in radians: the chord |R up_map - up_camera|
+/// is the tilt error in radians while it is small.
+struct UnitGravity {
+  Eigen::Vector3d up_in_map, up_in_camera;
+  double sigma_rad;
+};
+
 /// The camera-frame dual quadric of an ellipsoid at a pose: T Q* T^T with T = [R t; 0 1].
 Eigen::Matrix4d cameraDualQuadric(const Ellipsoid& e, const Pose& pose) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
@@ -56,6 +63,12 @@ struct Problem {
   std::vector<double> object_scale;  // sqrt(a b) of each observed ellipse
   const std::vector<PointMatch>& points;
   const RefinerOptions& opt;
+  const UnitGravity* gravity = nullptr;
+
+  /// The sigma-normalised gravity residual.
+  Eigen::Vector3d gravityResidual(const Pose& pose) const {
+    return (pose.rotation() * gravity->up_in_map - gravity->up_in_camera) / gravity->sigma_rad;
+  }
 
   /// Robust cost; false when an object no longer projects to an ellipse or a point is behind.
   bool cost(const Pose& pose, double* total) const {
@@ -76,6 +89,7 @@ struct Problem {
       loss(opt.point_loss, opt.point_loss_scale, s, &rho, &drho);
       sum += opt.point_weight * rho;
     }
+    if (gravity) sum += gravityResidual(pose).squaredNorm();
     *total = sum;
     return std::isfinite(sum);
   }
@@ -151,6 +165,15 @@ struct Problem {
       *H += opt.point_weight * drho * J.transpose() * J;
       *g += opt.point_weight * drho * J.transpose() * res;
     }
+    if (gravity) {
+      // d/d omega of Exp(omega) R up = -[R up]x at omega = 0; translation does not enter.
+      const Eigen::Vector3d up = pose.rotation() * gravity->up_in_map;
+      Eigen::Matrix<double, 3, 6> J = Eigen::Matrix<double, 3, 6>::Zero();
+      J.leftCols<3>() << 0, up(2), -up(1), -up(2), 0, up(0), up(1), -up(0), 0;
+      J /= gravity->sigma_rad;
+      *H += J.transpose() * J;
+      *g += J.transpose() * gravityResidual(pose);
+    }
     return H->allFinite() && g->allFinite();
   }
 };
@@ -220,6 +243,19 @@ struct CeresPointCost {
   double inv_sigma;
 };
 
+/// Ceres cost of the gravity prior: (R up_map - up_camera) / sigma.
+struct CeresGravityCost {
+  explicit CeresGravityCost(const UnitGravity& g) : g(g) {}
+  template <typename T>
+  bool operator()(const T* q, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> quat(q);
+    const Eigen::Matrix<T, 3, 1> up = quat.normalized() * g.up_in_map.cast<T>();
+    for (int k = 0; k < 3; ++k) r[k] = (up(k) - T(g.up_in_camera(k))) / T(g.sigma_rad);
+    return true;
+  }
+  UnitGravity g;
+};
+
 ceres::LossFunction* makeLoss(RobustLoss type, double scale, double weight) {
   ceres::LossFunction* loss = nullptr;
   if (type == RobustLoss::Huber) loss = new ceres::HuberLoss(scale);
@@ -246,6 +282,9 @@ Pose solveWithCeres(const Problem& problem, const Pose& initial, const RefinerOp
     cp.AddResidualBlock(cost, makeLoss(opt.point_loss, opt.point_loss_scale, opt.point_weight), q.coeffs().data(),
                         t.data());
   }
+  if (problem.gravity)
+    cp.AddResidualBlock(new ceres::AutoDiffCostFunction<CeresGravityCost, 3, 4>(new CeresGravityCost(*problem.gravity)),
+                        nullptr, q.coeffs().data());
   cp.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
@@ -263,7 +302,8 @@ Pose solveWithCeres(const Problem& problem, const Pose& initial, const RefinerOp
 }  // namespace
 
 RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std::vector<EllipseMatch>& objects,
-                            const std::vector<PointMatch>& points, const RefinerOptions& options) {
+                            const std::vector<PointMatch>& points, const RefinerOptions& options,
+                            const std::optional<GravityPrior>& gravity) {
   RefinementResult result;
   result.pose = initial;
   result.fell_back = true;
@@ -285,7 +325,16 @@ RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std:
     fillResiduals(result);
     return result;
   }
-  Problem problem{K, {}, {}, points, options};
+  if (gravity && !gravity->isValid()) {
+    result.message = "invalid gravity prior (zero or non-finite direction, or sigma <= 0)";
+    fillResiduals(result);
+    return result;
+  }
+  std::optional<UnitGravity> unit_gravity;
+  if (gravity)
+    unit_gravity = UnitGravity{gravity->up_in_map.normalized(), gravity->up_in_camera.normalized(),
+                               gravity->sigma_deg * M_PI / 180.0};
+  Problem problem{K, {}, {}, points, options, unit_gravity ? &*unit_gravity : nullptr};
   for (const EllipseMatch& m : objects) {
     if (!m.observed.isValid() || !project(m.ellipsoid, K, initial)) continue;
     problem.objects.push_back(&m);

@@ -6,7 +6,8 @@
 /// (core/distances.hpp, wasserstein2Residual) and s_i = sqrt(a_i b_i), the observed ellipse's
 /// geometric-mean radius: dividing by it makes the term scale-free, so a 20-px cup and a
 /// 200-px monitor that are both off by 10% of their size weigh alike. Optional keypoint
-/// reprojection residuals (the paper's "objects + points") join the same problem.
+/// reprojection residuals (the paper's "objects + points") and a gravity prior
+/// (|R up_map - up_camera|^2 / sigma^2, not robustified) join the same problem.
 ///
 /// The default backend is Levenberg-Marquardt on a left perturbation of the pose, derivatives
 /// by forward automatic differentiation (Ceres Jets) seeded analytically, robust losses by
@@ -16,12 +17,14 @@
 /// returned pose never has a higher cost than the one given: if it would, the given pose is
 /// returned and `fell_back` says so.
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/ellipsoid.hpp"
+#include "ellreloc/pose/gravity_prior.hpp"
 
 namespace ellreloc {
 
@@ -70,8 +73,10 @@ struct RefinementResult {
 };
 
 /// Refines `initial`. Matches whose ellipsoid does not project at the initial pose are left
-/// out (their residual is -1). With no usable match it falls back and says why.
+/// out (their residual is -1). With no usable match it falls back and says why. A gravity
+/// prior keeps the pose's tilt near the measured one; with it one object suffices.
 RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std::vector<EllipseMatch>& objects,
-                            const std::vector<PointMatch>& points = {}, const RefinerOptions& options = {});
+                            const std::vector<PointMatch>& points = {}, const RefinerOptions& options = {},
+                            const std::optional<GravityPrior>& gravity = std::nullopt);
 
 }  // namespace ellreloc

@@ -1,0 +1,181 @@
+#include "ellreloc/pose/few_object_poses.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/projection.hpp"
+
+namespace ellreloc {
+
+std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Matrix3d& R_cw,
+                                           const EllipseMatch& match) {
+  const Ellipse& observed = match.observed;
+  const Ellipsoid& e = match.ellipsoid;
+  if (!K.isValid() || !observed.isValid() || !e.isValid() || !isRotation(R_cw)) return std::nullopt;
+  const double observed_size = std::sqrt(observed.axes().prod());
+  Eigen::Vector3d bearing = K.bearing(observed.center());
+  // First depth from the silhouette seen along the bearing (orthographic): its radius
+  // det(S)^(1/4), S the camera-frame shape matrix restricted to the plane across the bearing.
+  const Eigen::Matrix3d M = R_cw * e.shapeMatrix() * R_cw.transpose();
+  const Eigen::Vector3d u = bearing.unitOrthogonal(), v = bearing.cross(u);
+  Eigen::Matrix2d S;
+  S << u.dot(M * u), u.dot(M * v), v.dot(M * u), v.dot(M * v);
+  const double focal = std::sqrt(K.fx * K.fy);
+  double depth = focal * std::pow(std::max(S.determinant(), 0.0), 0.25) / observed_size;
+  depth = std::max(depth, 1.01 * e.axes().maxCoeff());  // the camera stays outside
+  // Perspective: the image size goes as 1 / depth near the answer, and the centre of the
+  // projected ellipse is not the projection of the centre; a few fixed-point steps fix both.
+  for (int iteration = 0; iteration < 4; ++iteration) {
+    const Pose pose(R_cw, depth * bearing - R_cw * e.center());
+    const Projection p = project(e, K, pose);
+    if (!p) {
+      depth *= 2.0;  // too close: the ellipsoid reaches behind the principal plane
+      continue;
+    }
+    const Eigen::Vector2d offset = p.ellipse.center() - K.project(depth * bearing);
+    depth *= std::sqrt(p.ellipse.axes().prod()) / observed_size;
+    bearing = K.bearing(observed.center() - offset);
+  }
+  const Eigen::Vector3d t = depth * bearing - R_cw * e.center();
+  if (!t.allFinite() || !project(e, K, Pose(R_cw, t))) return std::nullopt;
+  return t;
+}
+
+namespace {
+
+/// The refiner's object cost (Cauchy or other loss on the normalised W2^2) plus the gravity
+/// term: the sweep ranks angles by what the refinement will minimise.
+double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<EllipseMatch>& matches,
+                 const std::optional<GravityPrior>& gravity, const RefinerOptions& opt) {
+  double total = 0.0;
+  for (const EllipseMatch& m : matches) {
+    const Projection p = project(m.ellipsoid, K, pose);
+    if (!p) return std::numeric_limits<double>::infinity();
+    const double s = wasserstein2Squared(m.observed, p.ellipse) / m.observed.axes().prod();
+    const double c2 = opt.object_loss_scale * opt.object_loss_scale;
+    total += opt.object_loss == RobustLoss::Cauchy ? c2 * std::log1p(s / c2) : s;
+  }
+  if (gravity) {
+    const double angle = gravity->errorDeg(pose) / gravity->sigma_deg;
+    total += angle * angle;
+  }
+  return std::isfinite(total) ? total : std::numeric_limits<double>::infinity();
+}
+
+/// Places every object at rotation R_cw; the translation is the mean of their placements.
+std::optional<Pose> placeAll(const Intrinsics& K, const Eigen::Matrix3d& R_cw,
+                             const std::vector<EllipseMatch>& matches) {
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  for (const EllipseMatch& m : matches) {
+    const auto ti = placeObject(K, R_cw, m);
+    if (!ti) return std::nullopt;
+    t += *ti / static_cast<double>(matches.size());
+  }
+  return Pose(R_cw, t);
+}
+
+/// Sweeps poseAt(angle) (a ScoredPose with the sweep cost, or nullopt) over a full turn,
+/// refines the best local minima of the cost and returns them, best first.
+template <typename PoseAt>
+std::vector<ScoredPose> sweepAndRefine(const Intrinsics& K, const std::vector<EllipseMatch>& matches,
+                                       const std::optional<GravityPrior>& gravity, const FewObjectOptions& opt,
+                                       PoseAt poseAt) {
+  const int steps = std::max(4, opt.angle_steps);
+  std::vector<double> cost(static_cast<size_t>(steps), std::numeric_limits<double>::infinity());
+  std::vector<Pose> pose(static_cast<size_t>(steps));
+  for (int k = 0; k < steps; ++k) {
+    const std::optional<ScoredPose> p = poseAt(2.0 * M_PI * k / steps);
+    if (!p) continue;
+    pose[k] = p->pose;
+    cost[k] = p->cost;
+  }
+  std::vector<int> minima;
+  for (int k = 0; k < steps; ++k) {
+    const double prev = cost[(k + steps - 1) % steps], next = cost[(k + 1) % steps];
+    if (std::isfinite(cost[k]) && cost[k] <= prev && cost[k] < next) minima.push_back(k);
+  }
+  std::sort(minima.begin(), minima.end(), [&](int x, int y) { return cost[x] < cost[y]; });
+  if (static_cast<int>(minima.size()) > opt.max_poses) minima.resize(static_cast<size_t>(std::max(0, opt.max_poses)));
+  std::vector<ScoredPose> out;
+  for (int k : minima) {
+    const RefinementResult r = refinePose(K, pose[k], matches, {}, opt.refiner, gravity);
+    const bool duplicate = std::any_of(out.begin(), out.end(), [&](const ScoredPose& p) {
+      return (p.pose.center() - r.pose.center()).norm() < 0.01 &&
+             rotationErrorDeg(p.pose.rotation(), r.pose.rotation()) < 0.5;
+    });
+    if (!duplicate && r.pose.isValid()) out.push_back({r.pose, r.fell_back ? cost[k] : r.final_cost});
+  }
+  std::sort(out.begin(), out.end(), [](const ScoredPose& x, const ScoredPose& y) { return x.cost < y.cost; });
+  return out;
+}
+
+bool usable(const Intrinsics& K, const EllipseMatch& m) {
+  return K.isValid() && m.observed.isValid() && m.ellipsoid.isValid();
+}
+
+}  // namespace
+
+std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
+                                            const std::optional<GravityPrior>& gravity,
+                                            const FewObjectOptions& options) {
+  if (!usable(K, a) || !usable(K, b) || (gravity && !gravity->isValid())) return {};
+  const Eigen::Vector3d world_axis = b.ellipsoid.center() - a.ellipsoid.center();
+  if (!(world_axis.norm() > 1e-9)) return {};
+  // The segment between the centres lies, in the camera, in the plane of the two bearings,
+  // between -bearing_a (b at depth 0) and bearing_b (a at depth 0); where depends on the
+  // ratio of the depths. The ratio of (object radius / image radius) guesses it, but
+  // elongated objects mislead it, and when the bearings are close a small error in the ratio
+  // turns the segment far: directions across the whole arc are tried as well.
+  const Eigen::Vector3d bearing_a = K.bearing(a.observed.center()), bearing_b = K.bearing(b.observed.center());
+  const auto depthScale = [&](const EllipseMatch& m) {
+    return std::cbrt(m.ellipsoid.axes().prod()) / std::sqrt(m.observed.axes().prod());
+  };
+  std::vector<Eigen::Vector3d> camera_axes{(depthScale(b) * bearing_b - depthScale(a) * bearing_a).normalized()};
+  const Eigen::Vector3d normal = bearing_a.cross(bearing_b);
+  if (normal.norm() > 1e-9) {
+    const Eigen::Vector3d in_plane = normal.normalized().cross(bearing_a);  // from -bearing_a towards bearing_b
+    const double arc = M_PI - std::acos(std::clamp(bearing_a.dot(bearing_b), -1.0, 1.0));
+    const int n = std::max(1, static_cast<int>(std::ceil(arc / (options.axis_step_deg * M_PI / 180.0))));
+    for (int i = 0; i < n; ++i) {
+      const double s = arc * (i + 0.5) / n;
+      camera_axes.push_back(std::cos(s) * -bearing_a + std::sin(s) * in_plane);
+    }
+  }
+  // For each: every rotation with R world_axis = camera_axis is an alignment followed by a
+  // turn about the world axis; at each angle, the best of the axes counts.
+  const Eigen::Vector3d w = world_axis.normalized();
+  std::vector<Eigen::Matrix3d> aligns;
+  for (const Eigen::Vector3d& c : camera_axes)
+    if (c.allFinite()) aligns.push_back(Eigen::Quaterniond::FromTwoVectors(w, c).toRotationMatrix());
+  const std::vector<EllipseMatch> matches{a, b};
+  return sweepAndRefine(K, matches, gravity, options, [&](double angle) -> std::optional<ScoredPose> {
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, w).toRotationMatrix();
+    std::optional<ScoredPose> best;
+    for (const Eigen::Matrix3d& align : aligns) {
+      const std::optional<Pose> pose = placeAll(K, align * turn, matches);
+      if (!pose) continue;
+      const double cost = sweepCost(K, *pose, matches, gravity, options.refiner);
+      if (!best || cost < best->cost) best = ScoredPose{*pose, cost};
+    }
+    return best;
+  });
+}
+
+std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMatch& a, const GravityPrior& gravity,
+                                           const FewObjectOptions& options) {
+  if (!usable(K, a) || !gravity.isValid()) return {};
+  // Every rotation with R up_map = up_camera: align, then turn about the map's up (the yaw).
+  const Eigen::Vector3d up = gravity.up_in_map.normalized();
+  const Eigen::Matrix3d align =
+      Eigen::Quaterniond::FromTwoVectors(up, gravity.up_in_camera.normalized()).toRotationMatrix();
+  const std::vector<EllipseMatch> matches{a};
+  return sweepAndRefine(K, matches, gravity, options, [&](double yaw) -> std::optional<ScoredPose> {
+    const std::optional<Pose> pose = placeAll(K, align * Eigen::AngleAxisd(yaw, up).toRotationMatrix(), matches);
+    if (!pose) return std::nullopt;
+    return ScoredPose{*pose, sweepCost(K, *pose, matches, gravity, options.refiner)};
+  });
+}
+
+}  // namespace ellreloc

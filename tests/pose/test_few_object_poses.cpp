@@ -1,0 +1,133 @@
+#include <gtest/gtest.h>
+
+#include "../random_geometry.hpp"
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/pose/few_object_poses.hpp"
+
+using namespace ellreloc;
+using ellreloc::test::uniform;
+
+namespace {
+
+/// A yaw-only object on a table or the floor with clearly distinct semi-axes (a symmetric
+/// one leaves the angle the solvers sweep unobservable).
+Ellipsoid randomObject(std::mt19937& rng) {
+  const double yaw = uniform(rng, -M_PI, M_PI);
+  const double a = uniform(rng, 0.08, 0.3);
+  return Ellipsoid({uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -0.5, 0.5)},
+                   {a, a * uniform(rng, 0.3, 0.6), a * uniform(rng, 0.6, 1.6)},
+                   Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix());
+}
+
+/// Observations of `n` objects from one random camera; centre noise in px, axis noise relative.
+bool observe(std::mt19937& rng, const Pose& pose, int n, double centre_px, double axis_rel,
+             std::vector<EllipseMatch>* out) {
+  const Intrinsics K = test::testIntrinsics();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  out->clear();
+  for (int attempt = 0; attempt < 200 && static_cast<int>(out->size()) < n; ++attempt) {
+    const Ellipsoid e = randomObject(rng);
+    const Projection p = project(e, K, pose);
+    if (!p) continue;
+    const Ellipse& el = p.ellipse;
+    const Box b = el.boundingBox();
+    if (b.x1 < 0 || b.y1 < 0 || b.x2 > K.width || b.y2 > K.height) continue;
+    out->push_back(
+        {Ellipse(el.center() + centre_px * Eigen::Vector2d(normal(rng), normal(rng)),
+                 el.axes().cwiseProduct(Eigen::Vector2d(1 + axis_rel * normal(rng), 1 + axis_rel * normal(rng))),
+                 el.angle() + 0.5 * axis_rel * normal(rng)),
+         e});
+  }
+  return static_cast<int>(out->size()) == n;
+}
+
+double positionError(const Pose& a, const Pose& b) { return (a.center() - b.center()).norm(); }
+double rotationError(const Pose& a, const Pose& b) { return rotationErrorDeg(a.rotation(), b.rotation()); }
+
+}  // namespace
+
+TEST(FewObjectPoses, PlaceObjectRecoversTheTranslationAtTheTrueRotation) {
+  std::mt19937 rng(1);
+  const Intrinsics K = test::testIntrinsics();
+  int checked = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 1, 0.0, 0.0, &m)) continue;
+    const auto t = placeObject(K, truth.rotation(), m[0]);
+    ASSERT_TRUE(t.has_value());
+    // Depth 2.5-5 m: 1 mm is 2-4e-4 relative.
+    EXPECT_LT((*t - truth.translation()).norm(), 1e-3) << "trial " << trial;
+    ++checked;
+  }
+  EXPECT_GT(checked, 150);
+}
+
+TEST(FewObjectPoses, TwoExactObjectsGiveThePose) {
+  std::mt19937 rng(2);
+  const Intrinsics K = test::testIntrinsics();
+  int trials = 0, first = 0, any = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 2, 0.0, 0.0, &m)) continue;
+    ++trials;
+    const auto poses = posesFromTwoObjects(K, m[0], m[1]);
+    ASSERT_LE(poses.size(), 3u);
+    for (size_t i = 0; i < poses.size(); ++i) {
+      const bool ok = positionError(poses[i].pose, truth) < 1e-3 && rotationError(poses[i].pose, truth) < 0.05;
+      if (ok && i == 0) ++first;
+      if (ok) {
+        ++any;
+        break;
+      }
+    }
+  }
+  std::printf("two exact objects: %d trials, first %d, any %d\n", trials, first, any);
+  EXPECT_GE(any, 0.95 * trials);
+  EXPECT_GE(first, 0.85 * trials);
+}
+
+TEST(FewObjectPoses, TwoNoisyObjects) {
+  std::mt19937 rng(3);
+  const Intrinsics K = test::testIntrinsics();
+  int trials = 0, first = 0;
+  std::vector<double> pos;
+  for (int trial = 0; trial < 100; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 2, 1.0, 0.03, &m)) continue;
+    ++trials;
+    const auto poses = posesFromTwoObjects(K, m[0], m[1]);
+    if (poses.empty()) continue;
+    pos.push_back(positionError(poses[0].pose, truth));
+    if (positionError(poses[0].pose, truth) < 0.15 && rotationError(poses[0].pose, truth) < 5.0) ++first;
+  }
+  std::sort(pos.begin(), pos.end());
+  std::printf("two noisy objects: %d trials, first within 15 cm / 5 deg %d, median %.3f m\n", trials, first,
+              pos[pos.size() / 2]);
+  EXPECT_GE(first, 0.7 * trials);
+}
+
+TEST(FewObjectPoses, OneObjectAndGravityGiveThePose) {
+  std::mt19937 rng(4);
+  const Intrinsics K = test::testIntrinsics();
+  int trials = 0, first = 0, any = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 1, 0.0, 0.0, &m)) continue;
+    ++trials;
+    const auto poses = posesFromOneObject(K, m[0], GravityPrior::atPose(truth));
+    for (size_t i = 0; i < poses.size(); ++i) {
+      const bool ok = positionError(poses[i].pose, truth) < 1e-3 && rotationError(poses[i].pose, truth) < 0.05;
+      if (ok && i == 0) ++first;
+      if (ok) {
+        ++any;
+        break;
+      }
+    }
+  }
+  std::printf("one exact object + gravity: %d trials, first %d, any %d\n", trials, first, any);
+  EXPECT_GE(any, 0.95 * trials);
+}
