@@ -22,14 +22,27 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-void evaluate(const char* name, const bench::RelocalizationDataset& d, const RelocalizerOptions& opt) {
+/// A simulated IMU: the map's up seen from the true pose, tilted by `sigma_deg` of noise.
+GravityPrior simulatedImu(const Eigen::Vector3d& up_in_map, const Pose& truth, double sigma_deg, std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, sigma_deg * M_PI / 180.0);
+  const Eigen::Vector3d tilt(g(rng), g(rng), g(rng));
+  GravityPrior prior = GravityPrior::atPose(truth, up_in_map, std::max(sigma_deg, 0.5));
+  prior.up_in_camera = Eigen::AngleAxisd(tilt.norm(), tilt.normalized()) * prior.up_in_camera;
+  return prior;
+}
+
+void evaluate(const char* name, const bench::RelocalizationDataset& d, const RelocalizerOptions& opt,
+              bool gravity = false) {
   const ObjectRelocalizer reloc(d.map, d.K, opt);
   std::vector<double> pos, rot, times;
   int valid = 0;
   double max_time = 0.0;
   long hyps = 0;
+  std::mt19937 imu_rng(7);
   for (const auto& q : d.queries) {
-    const RelocalizationResult r = reloc.relocalize(q.observations);
+    std::optional<GravityPrior> prior;
+    if (gravity) prior = simulatedImu(d.up_in_map, q.truth, 1.0, imu_rng);
+    const RelocalizationResult r = reloc.relocalize(q.observations, {}, prior);
     times.push_back(r.time_ms);
     max_time = std::max(max_time, r.time_ms);
     hyps += r.hypotheses;
@@ -42,7 +55,7 @@ void evaluate(const char* name, const bench::RelocalizationDataset& d, const Rel
       rot.push_back(re);
     }
   }
-  std::printf("| %-16s | %-22s | %5.1f%% | %6.1f cm | %5.2f deg | %8.2f ms | %8.1f ms | %8ld |\n", d.name.c_str(), name,
+  std::printf("| %-16s | %-32s | %5.1f%% | %6.1f cm | %5.2f deg | %8.2f ms | %8.1f ms | %8ld |\n", d.name.c_str(), name,
               100.0 * valid / d.queries.size(), 100.0 * median(pos), median(rot), median(times), max_time,
               hyps / static_cast<long>(d.queries.size()));
 }
@@ -129,6 +142,12 @@ int main(int argc, char** argv) {
         simulated(sim::ScenePreset::Cluttered, 200, 32)}) {
     evaluate("ours", d, RelocalizerOptions());
     evaluate("ours, no refinement", d, unrefined);
+    evaluate("ours + gravity (1 deg)", d, RelocalizerOptions(), true);
+    if (d.name.rfind("fr2", 0) == 0) {
+      RelocalizerOptions every;
+      every.gravity_in_every_refinement = true;
+      evaluate("ours + gravity, every refinement", d, every, true);
+    }
     if (ours_only) continue;
     // The exhaustive preset takes seconds per frame on the cluttered scene (40 objects, many
     // of one category): measured on 20 of its frames only.

@@ -24,6 +24,7 @@ struct RelocalizationDataset {
   ObjectMap map;
   Intrinsics K;
   std::vector<Query> queries;
+  Eigen::Vector3d up_in_map = Eigen::Vector3d::UnitZ();  ///< for the simulated IMU of the gravity rows
 };
 
 inline RelocalizationDataset loadFr2Desk(const std::string& data_dir) {
@@ -43,6 +44,11 @@ inline RelocalizationDataset loadFr2Desk(const std::string& data_dir) {
     }
     d.queries.push_back(std::move(q));
   }
+  // The map is in the first camera's frame: take the mean of the keyframes' image "up" (-y)
+  // as gravity, which a hand-held camera keeps near upright.
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const Query& q : d.queries) up -= q.truth.rotation().row(1).transpose();
+  d.up_in_map = up.normalized();
   return d;
 }
 

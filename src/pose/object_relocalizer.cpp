@@ -19,6 +19,8 @@ const char* toString(RelocalizationStatus s) {
       return "not enough observations";
     case RelocalizationStatus::NoConsistentHypothesis:
       return "no consistent hypothesis";
+    case RelocalizationStatus::InvalidInput:
+      return "invalid input";
   }
   return "unknown";
 }
@@ -133,7 +135,12 @@ struct PairEstimator {
   const Intrinsics& K;
   const RelocalizerOptions& opt;
   const Scorer& scorer;
+  const GravityPrior* gravity;          // drop poses that tilt the camera wrongly, when set
   mutable std::vector<Hypothesis> top;  // best distinct hypotheses, ascending cost
+
+  bool agreesWithGravity(const Pose& pose) const {
+    return !gravity || gravity->errorDeg(pose) <= std::max(opt.gravity_gate_deg, 5.0 * gravity->sigma_deg);
+  }
 
   size_t numData() const { return pairs.size(); }
 
@@ -161,6 +168,7 @@ struct PairEstimator {
     for (int i = 0; i < n; ++i) {
       Pose pose = poses[i];
       if (opt.correct_centres && !correctCentres(ob, oj, &pose)) continue;
+      if (!agreesWithGravity(pose)) continue;
       bool visible = true;
       for (int k = 0; k < 3 && visible; ++k) {
         const Projection p = project(map.objects[oj[k]].ellipsoid, K, pose);
@@ -222,17 +230,75 @@ struct PairEstimator {
   }
 };
 
+/// The P3P loop: RANSAC over triplets of candidate pairs with the sampler and budgets of the
+/// options. Fills the statistics of `result`; false when no triplet gave a pose.
+bool searchTriplets(const PairEstimator& estimator, const RelocalizerOptions& options, size_t num_objects, int usable,
+                    Pose* best, RelocalizationResult* result) {
+  RansacOptions ropt = options.ransac;
+  // Scoring a hypothesis costs up to (map objects) x (usable observations) overlaps: a large
+  // map with many observations gets fewer hypotheses, so that the worst case stays bounded.
+  if (options.max_overlap_evaluations > 0) {
+    const double per_hypothesis = static_cast<double>(num_objects) * static_cast<double>(usable);
+    const long affordable = static_cast<long>(static_cast<double>(options.max_overlap_evaluations) / per_hypothesis);
+    ropt.max_hypotheses = std::min(ropt.max_hypotheses, std::max(affordable, options.min_hypotheses_budget));
+  }
+  const int n = static_cast<int>(estimator.pairs.size());
+  HypothesisSampler sampler = options.sampler;
+  if (sampler == HypothesisSampler::Auto) {
+    const double triplets = static_cast<double>(n) * (n - 1) * (n - 2) / 6.0;
+    sampler = triplets <= options.max_exhaustive_triplets ? HypothesisSampler::Exhaustive : HypothesisSampler::Prosac;
+  }
+  if (sampler == HypothesisSampler::Exhaustive) {
+    // Small enough to try everything: the budgets still bound it.
+    ropt.min_iterations = std::max(ropt.min_iterations, std::numeric_limits<int>::max() / 2);
+    ropt.max_iterations = std::max(ropt.max_iterations, std::numeric_limits<int>::max() / 2);
+  }
+  RansacStats stats;
+  bool found = false;
+  switch (sampler) {
+    case HypothesisSampler::Auto:  // resolved above
+    case HypothesisSampler::Exhaustive: {
+      ExhaustiveSampler s(n, 3);
+      found = ransac(estimator, s, ropt, best, &stats);
+      break;
+    }
+    case HypothesisSampler::Uniform: {
+      UniformSampler s(n, 3, ropt.seed);
+      found = ransac(estimator, s, ropt, best, &stats);
+      break;
+    }
+    case HypothesisSampler::Prosac: {
+      // Reach uniform sampling over all pairs within ~1000 samples: the MSAC stopping rule
+      // assumes samples from all the data, and a wrong early model must not end the search
+      // while good pairs of lower quality are still out of reach.
+      ProsacSampler s(n, 3, ropt.seed, 1000);
+      found = ransac(estimator, s, ropt, best, &stats);
+      break;
+    }
+  }
+  result->hypotheses = stats.hypotheses;
+  result->iterations = stats.iterations;
+  result->budget_exhausted = stats.budget_exhausted;
+  return found;
+}
+
 }  // namespace
 
 ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
     : map_(std::move(map)), K_(K), options_(std::move(options)) {}
 
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations) const {
-  return relocalize(observations, {});
+  return relocalize(observations, {}, std::nullopt);
 }
 
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations,
                                                    const std::vector<Keypoint>& keypoints) const {
+  return relocalize(observations, keypoints, std::nullopt);
+}
+
+RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations,
+                                                   const std::vector<Keypoint>& keypoints,
+                                                   const std::optional<GravityPrior>& gravity) const {
   std::vector<PointMatch> points;
   for (const Keypoint& k : keypoints)
     if (k.point_index >= 0 && static_cast<size_t>(k.point_index) < map_.points.size() && k.uv.allFinite() &&
@@ -246,7 +312,10 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
-  if (!K_.isValid()) return finish(RelocalizationStatus::NotEnoughObservations, "invalid intrinsics");
+  if (!K_.isValid()) return finish(RelocalizationStatus::InvalidInput, "invalid intrinsics");
+  if (gravity && !gravity->isValid())
+    return finish(RelocalizationStatus::InvalidInput,
+                  "invalid gravity prior (zero or non-finite direction, or sigma not positive)");
 
   // Usable observations and their candidate objects (same category).
   std::vector<char> valid(observations.size(), 0);
@@ -277,62 +346,72 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     valid[i] = 1;
     ++usable;
   }
-  if (usable < 3)
+  // Three observations for P3P; two for the two-object solver; one with gravity.
+  const bool few = options_.few_object_solvers;
+  const int needed = !few ? 3 : (gravity ? 1 : 2);
+  if (usable < needed)
     return finish(RelocalizationStatus::NotEnoughObservations,
-                  std::to_string(usable) + " usable observation(s) with a candidate object; 3 are needed");
+                  std::to_string(usable) + " usable observation(s) with a candidate object; " +
+                      std::to_string(needed) + " needed" +
+                      (few && !gravity && usable == 1 ? " (or 1 with a gravity prior)" : ""));
 
   std::stable_sort(pairs.begin(), pairs.end(),
                    [](const CandidatePair& a, const CandidatePair& b) { return a.quality > b.quality; });
   const Scorer scorer(observations, valid, candidates, map_, K_, options_);
-  const PairEstimator estimator{pairs, observations, map_, K_, options_, scorer, {}};
-  RansacOptions ropt = options_.ransac;
-  // Scoring a hypothesis costs up to (map objects) x (usable observations) overlaps: a large
-  // map with many observations gets fewer hypotheses, so that the worst case stays bounded.
-  if (options_.max_overlap_evaluations > 0) {
-    const double per_hypothesis = static_cast<double>(map_.objects.size()) * static_cast<double>(usable);
-    const long affordable = static_cast<long>(static_cast<double>(options_.max_overlap_evaluations) / per_hypothesis);
-    ropt.max_hypotheses = std::min(ropt.max_hypotheses, std::max(affordable, options_.min_hypotheses_budget));
-  }
-  const int n = static_cast<int>(pairs.size());
-  HypothesisSampler sampler = options_.sampler;
-  if (sampler == HypothesisSampler::Auto) {
-    const double triplets = static_cast<double>(n) * (n - 1) * (n - 2) / 6.0;
-    sampler = triplets <= options_.max_exhaustive_triplets ? HypothesisSampler::Exhaustive : HypothesisSampler::Prosac;
-  }
-  if (sampler == HypothesisSampler::Exhaustive) {
-    // Small enough to try everything: the budgets still bound it.
-    ropt.min_iterations = std::max(ropt.min_iterations, std::numeric_limits<int>::max() / 2);
-    ropt.max_iterations = std::max(ropt.max_iterations, std::numeric_limits<int>::max() / 2);
-  }
+  const PairEstimator estimator{pairs, observations, map_, K_, options_, scorer, gravity ? &*gravity : nullptr, {}};
+  // The prior joins a refinement where the objects leave the tilt weakly constrained.
+  const auto refinementGravity = [&](size_t matched) {
+    return matched < 3 || options_.gravity_in_every_refinement ? gravity : std::nullopt;
+  };
   Pose best;
-  RansacStats stats;
   bool found = false;
-  switch (sampler) {
-    case HypothesisSampler::Auto:  // resolved above
-    case HypothesisSampler::Exhaustive: {
-      ExhaustiveSampler s(n, 3);
-      found = ransac(estimator, s, ropt, &best, &stats);
-      break;
-    }
-    case HypothesisSampler::Uniform: {
-      UniformSampler s(n, 3, ropt.seed);
-      found = ransac(estimator, s, ropt, &best, &stats);
-      break;
-    }
-    case HypothesisSampler::Prosac: {
-      // Reach uniform sampling over all pairs within ~1000 samples: the MSAC stopping rule
-      // assumes samples from all the data, and a wrong early model must not end the search
-      // while good pairs of lower quality are still out of reach.
-      ProsacSampler s(n, 3, ropt.seed, 1000);
-      found = ransac(estimator, s, ropt, &best, &stats);
-      break;
-    }
+  if (usable >= 3) found = searchTriplets(estimator, options_, map_.objects.size(), usable, &best, &result);
+
+  // Few observations, or no triplet explains three: poses from pairs, or from one object and
+  // gravity. They compete with the triplets' poses in the same score.
+  size_t best_inliers = 0;
+  if (found) {
+    std::vector<Match> m;
+    scorer.cost(best, kScoringIoUVertices, &m);
+    best_inliers = m.size();
   }
-  result.hypotheses = stats.hypotheses;
-  result.iterations = stats.iterations;
-  result.budget_exhausted = stats.budget_exhausted;
+  if (few && (usable <= options_.pair_search_max_observations || best_inliers < 3)) {
+    const long before = result.hypotheses;
+    const auto consider = [&](const std::vector<ScoredPose>& poses, const std::vector<int>& own) {
+      for (const ScoredPose& p : poses) {
+        if (!estimator.agreesWithGravity(p.pose)) continue;
+        bool visible = true;  // the pairs the pose came from must match at it
+        for (size_t k = 0; k < own.size() && visible; ++k) {
+          const CandidatePair& c = pairs[static_cast<size_t>(own[k])];
+          const Projection proj = project(map_.objects[c.obj].ellipsoid, K_, p.pose);
+          visible = proj.ok() && estimator.overlap(observations[c.obs], proj.ellipse) >= options_.min_overlap;
+        }
+        if (!visible) continue;
+        ++result.hypotheses;
+        int inliers = 0;
+        estimator.score(p.pose, &inliers);
+        found = true;
+      }
+    };
+    const auto matchOf = [&](const CandidatePair& c) {
+      return EllipseMatch{observations[c.obs].ellipse, map_.objects[c.obj].ellipsoid};
+    };
+    long tried = 0;
+    for (size_t i = 0; i < pairs.size() && tried < options_.max_pair_hypotheses; ++i)
+      for (size_t j = i + 1; j < pairs.size() && tried < options_.max_pair_hypotheses; ++j) {
+        if (pairs[i].obs == pairs[j].obs || pairs[i].obj == pairs[j].obj) continue;
+        ++tried;
+        consider(posesFromTwoObjects(K_, matchOf(pairs[i]), matchOf(pairs[j]), gravity, options_.few_object),
+                 {static_cast<int>(i), static_cast<int>(j)});
+      }
+    if (gravity && usable == 1)
+      for (size_t i = 0; i < pairs.size() && tried < options_.max_pair_hypotheses; ++i, ++tried)
+        consider(posesFromOneObject(K_, matchOf(pairs[i]), *gravity, options_.few_object), {static_cast<int>(i)});
+    result.few_object_hypotheses = result.hypotheses - before;
+    if (!estimator.top.empty()) best = estimator.top.front().pose;
+  }
   if (!found)
-    return finish(RelocalizationStatus::NoConsistentHypothesis, "no triplet gave a pose with the objects in view");
+    return finish(RelocalizationStatus::NoConsistentHypothesis, "no hypothesis gave a pose with its objects in view");
 
   // Refine the best distinct hypotheses on all their matches; keep what scores best.
   std::vector<Match> matches;
@@ -341,11 +420,14 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     Pose candidate = h.pose;
     bool refined = false;
     double cost = scorer.cost(candidate, 128, &matches);
-    if (options_.refine && static_cast<int>(matches.size()) >= 2) {
+    const int min_matches = gravity ? 1 : 2;
+    if (options_.refine && static_cast<int>(matches.size()) >= min_matches) {
       std::vector<EllipseMatch> em;
       for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
-      const RefinementResult r = refinePose(K_, candidate, em, {}, options_.refiner);
-      if (!r.fell_back) {
+      // Gravity only where the objects leave the pose weakly constrained.
+      const RefinementResult r =
+          refinePose(K_, candidate, em, {}, options_.refiner, gravity);
+      if (!r.fell_back && estimator.agreesWithGravity(r.pose)) {
         const double refined_cost = scorer.cost(r.pose, 128);
         if (refined_cost <= cost) {
           candidate = r.pose;
@@ -366,10 +448,10 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   if (!points.empty() && options_.refine && !matches.empty()) {
     std::vector<EllipseMatch> em;
     for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
-    const RefinementResult r = refinePose(K_, best, em, points, options_.refiner);
+    const RefinementResult r = refinePose(K_, best, em, points, options_.refiner, refinementGravity(matches.size()));
     std::vector<Match> with_points;
     const double cost_with_points = r.fell_back ? 0.0 : scorer.cost(r.pose, 128, &with_points);
-    if (!r.fell_back && with_points.size() >= matches.size()) {
+    if (!r.fell_back && with_points.size() >= matches.size() && estimator.agreesWithGravity(r.pose)) {
       best = r.pose;
       final_cost = cost_with_points;
       matches = std::move(with_points);
@@ -384,10 +466,11 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     sum += m.overlap;
   }
   result.mean_overlap = matches.empty() ? 0.0 : sum / matches.size();
-  if (static_cast<int>(matches.size()) < options_.min_inliers)
+  const int min_inliers = usable == 1 ? 1 : options_.min_inliers;  // a single observation needs gravity (above)
+  if (static_cast<int>(matches.size()) < min_inliers)
     return finish(RelocalizationStatus::NoConsistentHypothesis, "best pose explains " + std::to_string(matches.size()) +
                                                                     " observation(s); " +
-                                                                    std::to_string(options_.min_inliers) + " needed");
+                                                                    std::to_string(min_inliers) + " needed");
   return finish(RelocalizationStatus::Success, "");
 }
 

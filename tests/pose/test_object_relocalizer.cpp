@@ -99,10 +99,15 @@ TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
   Synthetic s = makeScene(rng, 12, 6);
   while (s.observations.size() < 5) s = makeScene(rng, 12, 6);
   const ObjectRelocalizer reloc(s.map, K);
-  // Fewer than three observations.
-  const std::vector<Observation> two(s.observations.begin(), s.observations.begin() + 2);
-  EXPECT_EQ(reloc.relocalize(two).status, RelocalizationStatus::NotEnoughObservations);
+  // One observation without gravity; none at all; fewer than three for the OA-SLAM preset.
+  const std::vector<Observation> one(s.observations.begin(), s.observations.begin() + 1);
+  const RelocalizationResult r1 = reloc.relocalize(one);
+  EXPECT_EQ(r1.status, RelocalizationStatus::NotEnoughObservations);
+  EXPECT_NE(r1.reason.find("with a gravity prior"), std::string::npos) << r1.reason;
   EXPECT_EQ(reloc.relocalize({}).status, RelocalizationStatus::NotEnoughObservations);
+  const std::vector<Observation> two(s.observations.begin(), s.observations.begin() + 2);
+  EXPECT_EQ(ObjectRelocalizer(s.map, K, RelocalizerOptions::oaSlam()).relocalize(two).status,
+            RelocalizationStatus::NotEnoughObservations);
   // No map object of the observed categories.
   std::vector<Observation> unknown = s.observations;
   for (auto& o : unknown) o.category = 999;
@@ -123,9 +128,14 @@ TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
   ASSERT_EQ(rb.skipped.size(), 2u);
   EXPECT_EQ(rb.skipped[0].first, static_cast<int>(bad.size()) - 2);
   EXPECT_LT(positionError(rb.pose, s.truth), 0.02);
-  // Invalid intrinsics.
+  // Invalid intrinsics, invalid gravity prior.
   EXPECT_EQ(ObjectRelocalizer(s.map, Intrinsics()).relocalize(s.observations).status,
-            RelocalizationStatus::NotEnoughObservations);
+            RelocalizationStatus::InvalidInput);
+  GravityPrior zero;
+  zero.up_in_camera.setZero();
+  const RelocalizationResult rg = reloc.relocalize(s.observations, {}, zero);
+  EXPECT_EQ(rg.status, RelocalizationStatus::InvalidInput);
+  EXPECT_NE(rg.reason.find("gravity"), std::string::npos);
 }
 
 // A host process must be able to bound the work: 200 objects of one category and 50

@@ -12,7 +12,15 @@
 /// truncated cost sum_i min(1 - overlap_i, 1 - min_overlap): bounded, so a wrong or missed
 /// detection costs at most a constant. The best few distinct hypotheses are refined with the
 /// Wasserstein refiner on all their inliers and rescored.
+///
+/// Frames with few observations: with at most `pair_search_max_observations` usable
+/// observations (or when no triplet explains three of them), pairs of (observation, object)
+/// pairs also give poses through the two-object solver (few_object_poses.hpp), so a frame
+/// with two detections, or with three of which one is wrong, still gets a pose. With a
+/// gravity prior, a single observation gives poses too (one object + gravity), and every
+/// hypothesis whose tilt disagrees with gravity is dropped.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +28,8 @@
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/observation.hpp"
+#include "ellreloc/pose/few_object_poses.hpp"
+#include "ellreloc/pose/gravity_prior.hpp"
 #include "ellreloc/pose/ransac.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
@@ -51,7 +61,28 @@ struct RelocalizerOptions {
   /// mice and books with plants, and maps that keep a label histogram know it. With no
   /// histogram only equal categories match. Above 0.5, only the majority label matches.
   double min_category_share = 0.05;
-  int min_inliers = 3;          ///< fewer matched observations: no consistent hypothesis
+  /// Fewer matched observations: no consistent hypothesis. Two objects constrain a pose
+  /// (their ellipses give 10 equations for 6 unknowns); a frame with a single usable
+  /// observation needs a gravity prior and then one suffices.
+  int min_inliers = 2;
+  /// Poses from one or two objects (few_object_poses.hpp) for frames with few observations.
+  bool few_object_solvers = true;
+  /// With at most this many usable observations, pairs are tried besides triplets (they are
+  /// also tried when no triplet explains three observations). Raising it to 3 or 4 rescues
+  /// frames where one of three or four detections is wrong, but a pose fitted to two objects
+  /// can then outscore the right one on an inexact map: on fr2_desk 2 did best (docs/benchmarks.md).
+  int pair_search_max_observations = 2;
+  long max_pair_hypotheses = 200;  ///< pairs of candidate pairs given to the two-object solver
+  FewObjectOptions few_object;
+  /// With a gravity prior, hypotheses tilted more than max(gravity_gate_deg, 5 sigma) from
+  /// it are dropped: loose, because a P3P pose from three box centres is often 5-10 degrees
+  /// off before refinement.
+  double gravity_gate_deg = 15.0;
+  /// Also use the gravity prior when refining poses that rest on three or more objects. On
+  /// an exact map this costs accuracy (the IMU's noise enters the pose: 0.18 -> 0.52 deg on
+  /// the synthetic room with a 1 deg IMU); on an inexact map it helps (fr2_desk with a
+  /// simulated IMU: 73.7% -> 76.3% valid). Off: objects, when there are enough, fix the tilt.
+  bool gravity_in_every_refinement = false;
   bool correct_centres = true;  ///< re-solve P3P with the projected-centre offset removed
   /// Drop a pose at once when one of its own three pairs overlaps less than min_overlap:
   /// P3P fits the centres exactly, but a wrong triplet rarely fits the three shapes, and this
@@ -87,6 +118,8 @@ struct RelocalizerOptions {
     o.correct_centres = false;
     o.check_sample_overlap = false;
     o.min_category_share = 1.0;  // equal (majority) categories only
+    o.min_inliers = 3;
+    o.few_object_solvers = false;
     o.min_overlap = 0.25;
     o.refine = false;
     o.refine_top_k = 1;
@@ -101,8 +134,9 @@ struct RelocalizerOptions {
 
 enum class RelocalizationStatus {
   Success,
-  NotEnoughObservations,   ///< fewer than three usable observations with a candidate object
+  NotEnoughObservations,   ///< too few usable observations with a candidate object (see RelocalizerOptions)
   NoConsistentHypothesis,  ///< no pose explains at least min_inliers observations
+  InvalidInput,            ///< invalid intrinsics or gravity prior
 };
 
 const char* toString(RelocalizationStatus s);
@@ -125,6 +159,7 @@ struct RelocalizationResult {
   int iterations = 0;
   bool budget_exhausted = false;
   bool refined = false;
+  long few_object_hypotheses = 0;  ///< poses from the one- and two-object solvers (also in `hypotheses`)
   double time_ms = 0.0;
 };
 
@@ -142,6 +177,13 @@ class ObjectRelocalizer {
   /// map().points or that are not finite are ignored.
   RelocalizationResult relocalize(const std::vector<Observation>& observations,
                                   const std::vector<Keypoint>& keypoints) const;
+  /// The same, with the direction of gravity in the camera (an IMU) and in the map: it drops
+  /// hypotheses that tilt the camera wrongly, lets a single observation give a pose, and
+  /// joins the refinement of poses that rest on fewer than three objects (with three or more
+  /// the objects fix the tilt better than an IMU prior does). An invalid prior (zero or
+  /// non-finite) is an InvalidInput status.
+  RelocalizationResult relocalize(const std::vector<Observation>& observations, const std::vector<Keypoint>& keypoints,
+                                  const std::optional<GravityPrior>& gravity) const;
 
   const ObjectMap& map() const { return map_; }
   const Intrinsics& intrinsics() const { return K_; }
