@@ -351,9 +351,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   const int needed = !few ? 3 : (gravity ? 1 : 2);
   if (usable < needed)
     return finish(RelocalizationStatus::NotEnoughObservations,
-                  std::to_string(usable) + " usable observation(s) with a candidate object; " +
-                      std::to_string(needed) + " needed" +
-                      (few && !gravity && usable == 1 ? " (or 1 with a gravity prior)" : ""));
+                  std::to_string(usable) + " usable observation(s) with a candidate object; " + std::to_string(needed) +
+                      " needed" + (few && !gravity && usable == 1 ? " (or 1 with a gravity prior)" : ""));
 
   std::stable_sort(pairs.begin(), pairs.end(),
                    [](const CandidatePair& a, const CandidatePair& b) { return a.quality > b.quality; });
@@ -425,8 +424,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
       std::vector<EllipseMatch> em;
       for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
       // Gravity only where the objects leave the pose weakly constrained.
-      const RefinementResult r =
-          refinePose(K_, candidate, em, {}, options_.refiner, gravity);
+      const RefinementResult r = refinePose(K_, candidate, em, {}, options_.refiner, gravity);
       if (!r.fell_back && estimator.agreesWithGravity(r.pose)) {
         const double refined_cost = scorer.cost(r.pose, 128);
         if (refined_cost <= cost) {
@@ -469,8 +467,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   const int min_inliers = usable == 1 ? 1 : options_.min_inliers;  // a single observation needs gravity (above)
   if (static_cast<int>(matches.size()) < min_inliers)
     return finish(RelocalizationStatus::NoConsistentHypothesis, "best pose explains " + std::to_string(matches.size()) +
-                                                                    " observation(s); " +
-                                                                    std::to_string(min_inliers) + " needed");
+                                                                    " observation(s); " + std::to_string(min_inliers) +
+                                                                    " needed");
   return finish(RelocalizationStatus::Success, "");
 }
 

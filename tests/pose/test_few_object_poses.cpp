@@ -83,9 +83,9 @@ TEST(FewObjectPoses, TwoExactObjectsGiveThePose) {
       }
     }
   }
-  std::printf("two exact objects: %d trials, first %d, any %d\n", trials, first, any);
+  // Measured 98 of 100, both first and among the returned poses.
   EXPECT_GE(any, 0.95 * trials);
-  EXPECT_GE(first, 0.85 * trials);
+  EXPECT_GE(first, 0.95 * trials);
 }
 
 TEST(FewObjectPoses, TwoNoisyObjects) {
@@ -103,10 +103,11 @@ TEST(FewObjectPoses, TwoNoisyObjects) {
     pos.push_back(positionError(poses[0].pose, truth));
     if (positionError(poses[0].pose, truth) < 0.15 && rotationError(poses[0].pose, truth) < 5.0) ++first;
   }
+  // 1 px and 3% on two objects 2.5-5 m away: measured 71 of 100 first poses within 15 cm /
+  // 5 deg, median position error 9.7 cm (two objects constrain the pose weakly).
   std::sort(pos.begin(), pos.end());
-  std::printf("two noisy objects: %d trials, first within 15 cm / 5 deg %d, median %.3f m\n", trials, first,
-              pos[pos.size() / 2]);
-  EXPECT_GE(first, 0.7 * trials);
+  EXPECT_GE(first, 0.65 * trials);
+  EXPECT_LT(pos[pos.size() / 2], 0.15);
 }
 
 TEST(FewObjectPoses, OneObjectAndGravityGiveThePose) {
@@ -128,6 +129,54 @@ TEST(FewObjectPoses, OneObjectAndGravityGiveThePose) {
       }
     }
   }
-  std::printf("one exact object + gravity: %d trials, first %d, any %d\n", trials, first, any);
-  EXPECT_GE(any, 0.95 * trials);
+  // Measured 96 of 100 among the returned poses; first only about half the time, because an
+  // upright ellipsoid looks the same from the opposite side of its vertical axis.
+  EXPECT_GE(any, 0.93 * trials);
+}
+
+TEST(FewObjectPoses, RefinerWithGravityFixesThePoseFromOneObject) {
+  std::mt19937 rng(5);
+  const Intrinsics K = test::testIntrinsics();
+  int trials = 0, converged = 0, converged_ceres = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 1, 0.0, 0.0, &m)) continue;
+    ++trials;
+    // 3 degrees about the vertical and 5 cm off: one ellipse (5 equations) and gravity (2).
+    const Eigen::Matrix3d yaw = Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Pose start(truth.rotation() * yaw, truth.translation() + Eigen::Vector3d(0.03, -0.02, 0.04));
+    const RefinementResult r = refinePose(K, start, m, {}, {}, GravityPrior::atPose(truth));
+    ASSERT_FALSE(r.fell_back) << r.message;
+    RefinerOptions ceres;
+    ceres.backend = RefinerBackend::Ceres;
+    const RefinementResult rc = refinePose(K, start, m, {}, ceres, GravityPrior::atPose(truth));
+    converged += positionError(r.pose, truth) < 1e-3 && rotationError(r.pose, truth) < 0.05;
+    converged_ceres += positionError(rc.pose, truth) < 1e-3 && rotationError(rc.pose, truth) < 0.05;
+  }
+  EXPECT_GE(converged, trials - 2);
+  EXPECT_GE(converged_ceres, trials - 2);
+}
+
+TEST(FewObjectPoses, BadInputGivesNoPose) {
+  std::mt19937 rng(6);
+  const Intrinsics K = test::testIntrinsics();
+  const Pose truth = test::randomLookAtPose(rng);
+  std::vector<EllipseMatch> m;
+  while (!observe(rng, truth, 2, 0.0, 0.0, &m)) {
+  }
+  EllipseMatch nan_ellipse = m[0];
+  nan_ellipse.observed = Ellipse({std::nan(""), 1.0}, {5, 5}, 0);
+  EXPECT_TRUE(posesFromTwoObjects(K, nan_ellipse, m[1]).empty());
+  EXPECT_TRUE(posesFromTwoObjects(K, m[0], m[0]).empty());  // one ellipsoid centre twice
+  EXPECT_TRUE(posesFromTwoObjects(Intrinsics(), m[0], m[1]).empty());
+  GravityPrior zero = GravityPrior::atPose(truth);
+  zero.up_in_map.setZero();
+  EXPECT_TRUE(posesFromOneObject(K, m[0], zero).empty());
+  EXPECT_TRUE(posesFromTwoObjects(K, m[0], m[1], zero).empty());
+  EXPECT_FALSE(placeObject(K, Eigen::Matrix3d::Zero(), m[0]).has_value());
+  // The refiner refuses an invalid prior and says why.
+  const RefinementResult r = refinePose(K, truth, m, {}, {}, zero);
+  EXPECT_TRUE(r.fell_back);
+  EXPECT_NE(r.message.find("gravity"), std::string::npos);
 }

@@ -308,3 +308,76 @@ TEST(ObjectRelocalizer, KeypointsMatchedToMapPointsImproveAccuracy) {
 
 }  // namespace
 }  // namespace ellreloc
+
+// Two observations: the two-object solver gives the pose from the ellipses' shapes.
+TEST(ObjectRelocalizer, TwoObservationsGiveThePose) {
+  std::mt19937 rng(101);
+  const Intrinsics K = test::testIntrinsics();
+  int tried = 0, recovered = 0;
+  for (int trial = 0; trial < 60 && tried < 30; ++trial) {
+    Synthetic s = makeScene(rng, 12, 12, 0.0);  // one object per category: no ambiguity of labels
+    if (s.observations.size() < 2) continue;
+    s.observations.resize(2);
+    ++tried;
+    const RelocalizationResult r = ObjectRelocalizer(s.map, K).relocalize(s.observations);
+    if (r.status == RelocalizationStatus::Success && positionError(r.pose, s.truth) < 0.02 &&
+        rotationErrorDeg(r.pose.rotation(), s.truth.rotation()) < 0.5) {
+      ++recovered;
+      EXPECT_GT(r.few_object_hypotheses, 0);
+      ASSERT_EQ(r.inliers.size(), 2u);
+      for (const ObjectCorrespondence& c : r.inliers) EXPECT_EQ(c.object, s.object_of[c.observation]);
+    }
+  }
+  EXPECT_EQ(tried, 30);
+  // Measured 30 of 30; exact ellipses, but two small objects can fit a wrong pose too.
+  EXPECT_GE(recovered, 27);
+}
+
+// One observation and gravity: a pose that reproduces the ellipse with the measured tilt.
+// An ellipsoid looks the same from the opposite side of its vertical axis, so the pose is
+// the true one or its mirror about that axis.
+TEST(ObjectRelocalizer, OneObservationWithGravity) {
+  std::mt19937 rng(102);
+  const Intrinsics K = test::testIntrinsics();
+  int tried = 0, recovered = 0;
+  for (int trial = 0; trial < 60 && tried < 30; ++trial) {
+    Synthetic s = makeScene(rng, 12, 12, 0.0);
+    if (s.observations.empty()) continue;
+    s.observations.resize(1);
+    ++tried;
+    const ObjectRelocalizer reloc(s.map, K);
+    EXPECT_EQ(reloc.relocalize(s.observations).status, RelocalizationStatus::NotEnoughObservations);
+    const GravityPrior g = GravityPrior::atPose(s.truth);
+    const RelocalizationResult r = reloc.relocalize(s.observations, {}, g);
+    if (r.status != RelocalizationStatus::Success) continue;
+    const Ellipsoid& e = s.map.objects[s.object_of[0]].ellipsoid;
+    const Eigen::Matrix3d mirror = Eigen::AngleAxisd(M_PI, e.rotation().col(2)).toRotationMatrix();
+    const Pose mirrored(s.truth.rotation() * mirror.transpose(),
+                        s.truth.translation() + s.truth.rotation() * (e.center() - mirror.transpose() * e.center()));
+    const bool near_truth = positionError(r.pose, s.truth) < 0.02 || positionError(r.pose, mirrored) < 0.02;
+    EXPECT_LT(g.errorDeg(r.pose), 0.5);
+    recovered += near_truth;
+  }
+  EXPECT_EQ(tried, 30);
+  EXPECT_GE(recovered, 27);  // measured 30 of 30
+}
+
+// A gravity prior drops every pose that tilts the camera against it.
+TEST(ObjectRelocalizer, GravityPriorGatesHypotheses) {
+  std::mt19937 rng(103);
+  const Intrinsics K = test::testIntrinsics();
+  Synthetic s = makeScene(rng, 12, 6, 0.5);
+  while (s.observations.size() < 5) s = makeScene(rng, 12, 6, 0.5);
+  const ObjectRelocalizer reloc(s.map, K);
+  const RelocalizationResult right = reloc.relocalize(s.observations, {}, GravityPrior::atPose(s.truth));
+  ASSERT_EQ(right.status, RelocalizationStatus::Success) << right.reason;
+  EXPECT_LT(positionError(right.pose, s.truth), 0.05);
+  // Gravity 90 degrees off: no pose that explains the objects agrees with it.
+  GravityPrior wrong = GravityPrior::atPose(s.truth);
+  wrong.up_in_camera = s.truth.rotation() * Eigen::Vector3d::UnitX();
+  const RelocalizationResult r = reloc.relocalize(s.observations, {}, wrong);
+  if (r.status == RelocalizationStatus::Success) {
+    EXPECT_LE(wrong.errorDeg(r.pose), reloc.options().gravity_gate_deg + 1e-9);
+    EXPECT_GT(positionError(r.pose, s.truth), 0.05);
+  }
+}
