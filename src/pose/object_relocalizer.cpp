@@ -89,7 +89,7 @@ class Scorer {
     });
     std::fill(obs_used_.begin(), obs_used_.end(), 0);
     std::fill(obj_used_.begin(), obj_used_.end(), 0);
-    const double miss = 1.0 - opt_.min_overlap;
+    const double miss = opt_.unmatched_cost;
     double total = miss * num_valid_;
     if (out) out->clear();
     for (const Match& m : matches_) {
@@ -230,6 +230,47 @@ struct PairEstimator {
   }
 };
 
+/// Usable observations and their candidate objects (same category, or a share of the
+/// object's label histogram).
+struct Candidates {
+  std::vector<char> valid;                       // per observation
+  std::vector<std::vector<int>> of_observation;  // candidate objects of each observation
+  std::vector<CandidatePair> pairs;
+  int usable = 0;
+};
+
+Candidates collectCandidates(const std::vector<Observation>& observations, const ObjectMap& map,
+                             const RelocalizerOptions& options, std::vector<std::pair<int, std::string>>* skipped) {
+  Candidates c;
+  c.valid.assign(observations.size(), 0);
+  c.of_observation.resize(observations.size());
+  for (size_t i = 0; i < observations.size(); ++i) {
+    const Observation& o = observations[i];
+    if (!o.ellipse.isValid() || !o.box.isValid() || !std::isfinite(o.score)) {
+      skipped->emplace_back(static_cast<int>(i), "invalid ellipse, box or score (NaN, infinite or empty)");
+      continue;
+    }
+    for (size_t j = 0; j < map.objects.size(); ++j) {
+      const MapObject& m = map.objects[j];
+      const double share =
+          m.category == o.category ? std::max(m.categoryShare(o.category), 0.5) : m.categoryShare(o.category);
+      if (!m.ellipsoid.isValid() || !(share >= std::min(options.min_category_share, 0.5) &&
+                                      (m.category == o.category || share >= options.min_category_share)))
+        continue;
+      c.of_observation[i].push_back(static_cast<int>(j));
+      // Likelier labels, surer detections and larger objects first: PROSAC order.
+      c.pairs.push_back({static_cast<int>(i), static_cast<int>(j), share * o.score * std::cbrt(m.ellipsoid.volume())});
+    }
+    if (c.of_observation[i].empty()) {
+      skipped->emplace_back(static_cast<int>(i), "no map object of category " + std::to_string(o.category));
+      continue;
+    }
+    c.valid[i] = 1;
+    ++c.usable;
+  }
+  return c;
+}
+
 /// The P3P loop: RANSAC over triplets of candidate pairs with the sampler and budgets of the
 /// options. Fills the statistics of `result`; false when no triplet gave a pose.
 bool searchTriplets(const PairEstimator& estimator, const RelocalizerOptions& options, size_t num_objects, int usable,
@@ -287,6 +328,31 @@ bool searchTriplets(const PairEstimator& estimator, const RelocalizerOptions& op
 ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
     : map_(std::move(map)), K_(K), options_(std::move(options)) {}
 
+RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>& observations,
+                                                  const Pose& pose) const {
+  RelocalizationResult result;
+  result.pose = pose;
+  if (!K_.isValid() || !pose.isValid()) {
+    result.status = RelocalizationStatus::InvalidInput;
+    result.reason = !K_.isValid() ? "invalid intrinsics" : "invalid pose";
+    return result;
+  }
+  const Candidates cands = collectCandidates(observations, map_, options_, &result.skipped);
+  const Scorer scorer(observations, cands.valid, cands.of_observation, map_, K_, options_);
+  std::vector<Match> matches;
+  result.cost = scorer.cost(pose, 128, &matches);
+  double sum = 0.0;
+  for (const Match& m : matches) {
+    result.inliers.push_back({m.obs, m.obj, m.overlap});
+    sum += m.overlap;
+  }
+  result.mean_overlap = matches.empty() ? 0.0 : sum / matches.size();
+  const bool enough = static_cast<int>(matches.size()) >= std::min(options_.min_inliers, std::max(cands.usable, 1));
+  result.status = enough ? RelocalizationStatus::Success : RelocalizationStatus::NoConsistentHypothesis;
+  if (!enough) result.reason = "the pose explains " + std::to_string(matches.size()) + " observation(s)";
+  return result;
+}
+
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations) const {
   return relocalize(observations, {}, std::nullopt);
 }
@@ -317,35 +383,11 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     return finish(RelocalizationStatus::InvalidInput,
                   "invalid gravity prior (zero or non-finite direction, or sigma not positive)");
 
-  // Usable observations and their candidate objects (same category).
-  std::vector<char> valid(observations.size(), 0);
-  std::vector<std::vector<int>> candidates(observations.size());
-  std::vector<CandidatePair> pairs;
-  int usable = 0;
-  for (size_t i = 0; i < observations.size(); ++i) {
-    const Observation& o = observations[i];
-    if (!o.ellipse.isValid() || !o.box.isValid() || !std::isfinite(o.score)) {
-      result.skipped.emplace_back(static_cast<int>(i), "invalid ellipse, box or score (NaN, infinite or empty)");
-      continue;
-    }
-    for (size_t j = 0; j < map_.objects.size(); ++j) {
-      const MapObject& m = map_.objects[j];
-      const double share =
-          m.category == o.category ? std::max(m.categoryShare(o.category), 0.5) : m.categoryShare(o.category);
-      if (!m.ellipsoid.isValid() || !(share >= std::min(options_.min_category_share, 0.5) &&
-                                      (m.category == o.category || share >= options_.min_category_share)))
-        continue;
-      candidates[i].push_back(static_cast<int>(j));
-      // Likelier labels, surer detections and larger objects first: PROSAC order.
-      pairs.push_back({static_cast<int>(i), static_cast<int>(j), share * o.score * std::cbrt(m.ellipsoid.volume())});
-    }
-    if (candidates[i].empty()) {
-      result.skipped.emplace_back(static_cast<int>(i), "no map object of category " + std::to_string(o.category));
-      continue;
-    }
-    valid[i] = 1;
-    ++usable;
-  }
+  const Candidates cands = collectCandidates(observations, map_, options_, &result.skipped);
+  const std::vector<char>& valid = cands.valid;
+  const std::vector<std::vector<int>>& candidates = cands.of_observation;
+  std::vector<CandidatePair> pairs = cands.pairs;
+  const int usable = cands.usable;
   // Three observations for P3P; two for the two-object solver; one with gravity.
   const bool few = options_.few_object_solvers;
   const int needed = !few ? 3 : (gravity ? 1 : 2);
@@ -419,20 +461,23 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     Pose candidate = h.pose;
     bool refined = false;
     double cost = scorer.cost(candidate, 128, &matches);
-    const int min_matches = gravity ? 1 : 2;
-    if (options_.refine && static_cast<int>(matches.size()) >= min_matches) {
+    // Refine on the matches, match again at the refined pose, and repeat while that explains
+    // the observations better: a refined pose often brings more objects into overlap.
+    for (int round = 0; round < options_.refine_rounds && options_.refine; ++round) {
+      if (static_cast<int>(matches.size()) < (gravity ? 1 : 2)) break;
       std::vector<EllipseMatch> em;
       for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
-      // Gravity only where the objects leave the pose weakly constrained.
-      const RefinementResult r = refinePose(K_, candidate, em, {}, options_.refiner, gravity);
-      if (!r.fell_back && estimator.agreesWithGravity(r.pose)) {
-        const double refined_cost = scorer.cost(r.pose, 128);
-        if (refined_cost <= cost) {
-          candidate = r.pose;
-          cost = refined_cost;
-          refined = true;
-        }
-      }
+      const RefinementResult r = refinePose(K_, candidate, em, {}, options_.refiner, refinementGravity(em.size()));
+      if (r.fell_back || !estimator.agreesWithGravity(r.pose)) break;
+      std::vector<Match> rematched;
+      const double refined_cost = scorer.cost(r.pose, 128, &rematched);
+      if (refined_cost > cost) break;
+      const bool more = rematched.size() > matches.size();
+      candidate = r.pose;
+      cost = refined_cost;
+      refined = true;
+      matches = std::move(rematched);
+      if (!more) break;
     }
     if (cost < best_cost || (refined && cost <= best_cost)) {
       best_cost = cost;

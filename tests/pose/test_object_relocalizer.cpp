@@ -381,3 +381,28 @@ TEST(ObjectRelocalizer, GravityPriorGatesHypotheses) {
     EXPECT_GT(positionError(r.pose, s.truth), 0.05);
   }
 }
+
+// scorePose scores a given pose like relocalize() scores its own.
+TEST(ObjectRelocalizer, ScoresAGivenPose) {
+  std::mt19937 rng(104);
+  const Intrinsics K = test::testIntrinsics();
+  Synthetic s = makeScene(rng, 12, 12, 0.0);
+  while (s.observations.size() < 4) s = makeScene(rng, 12, 12, 0.0);
+  const ObjectRelocalizer reloc(s.map, K);
+  const RelocalizationResult at_truth = reloc.scorePose(s.observations, s.truth);
+  EXPECT_EQ(at_truth.status, RelocalizationStatus::Success);
+  ASSERT_EQ(at_truth.inliers.size(), s.observations.size());
+  for (const ObjectCorrespondence& c : at_truth.inliers) {
+    EXPECT_EQ(c.object, s.object_of[c.observation]);
+    EXPECT_GT(c.overlap, 0.99);  // exact projections
+  }
+  EXPECT_NEAR(at_truth.cost, 0.0, 0.01 * s.observations.size());
+  // Far off: nothing overlaps, every observation costs unmatched_cost.
+  const Pose away = Pose::lookAt(s.truth.center(), s.truth.center() - 3.0 * s.truth.rotation().row(2).transpose());
+  const RelocalizationResult r = reloc.scorePose(s.observations, away);
+  EXPECT_EQ(r.status, RelocalizationStatus::NoConsistentHypothesis);
+  EXPECT_TRUE(r.inliers.empty());
+  EXPECT_DOUBLE_EQ(r.cost, reloc.options().unmatched_cost * s.observations.size());
+  EXPECT_EQ(reloc.scorePose(s.observations, Pose(Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero())).status,
+            RelocalizationStatus::InvalidInput);
+}
