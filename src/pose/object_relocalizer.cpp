@@ -458,6 +458,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   std::vector<Match> matches;
   double best_cost = scorer.cost(best, 128, &matches);
   for (const Hypothesis& h : estimator.top) {
+    if (h.cost > estimator.top.front().cost + options_.refine_cost_margin) break;  // ascending costs
     Pose candidate = h.pose;
     bool refined = false;
     double cost = scorer.cost(candidate, 128, &matches);
