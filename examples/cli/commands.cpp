@@ -176,6 +176,13 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "paper" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
+  std::optional<GravityPrior> gravity;
+  if (a.camera_up.size() == 3 && a.map_up.size() == 3) {
+    gravity = GravityPrior{
+        {a.camera_up[0], a.camera_up[1], a.camera_up[2]}, {a.map_up[0], a.map_up[1], a.map_up[2]}, a.gravity_sigma_deg};
+    if (!gravity->isValid())
+      throw Error("--camera-up/--map-up/--gravity-sigma: directions must be finite and non-zero, sigma positive");
+  }
   // Keypoints per frame: from the detections file itself, or from a file with the same frames.
   std::vector<std::vector<Keypoint>> keypoints(frames.size());
   if (a.use_points) {
@@ -198,7 +205,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
         if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
           observations.push_back(*r.observation);
       observed[i] = static_cast<int>(observations.size());
-      results[i] = relocalizer.relocalize(observations, keypoints[i]);
+      results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
       ++finished;
     }
   };

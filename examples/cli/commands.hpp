@@ -3,6 +3,7 @@
 // ellreloc::Error on bad input (main turns it into one line and exit code 2).
 
 #include <string>
+#include <vector>
 
 namespace ellreloc::cli {
 
@@ -35,6 +36,8 @@ struct RelocalizeArgs {
   bool use_points = false;  ///< refine with the frames' keypoints matched to the map's points
   std::string points;       ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;
+  std::vector<double> camera_up, map_up;  ///< a gravity prior for every frame, when both are given
+  double gravity_sigma_deg = 2.0;
 };
 /// Returns the number of frames relocalized.
 int relocalize(const RelocalizeArgs& a, const Console& console);

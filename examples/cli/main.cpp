@@ -65,6 +65,18 @@ int main(int argc, char** argv) {
                                "layout), or from the detections file when no file is given")
                      ->expected(0, 1);
   r->add_option("--threads", rl.threads, "frames in parallel")->capture_default_str()->check(CLI::Range(1, 256));
+  auto* camera_up = r->add_option("--camera-up", rl.camera_up,
+                                  "gravity prior: the up direction in the camera frame (x right, y down, z forward), "
+                                  "for a camera at a fixed tilt, e.g. 0,-1,0 for a level camera")
+                        ->expected(3)
+                        ->delimiter(',');
+  auto* map_up = r->add_option("--map-up", rl.map_up, "gravity prior: the up direction in the map frame, e.g. 0,0,1")
+                     ->expected(3)
+                     ->delimiter(',');
+  camera_up->needs(map_up);
+  map_up->needs(camera_up);
+  r->add_option("--gravity-sigma", rl.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
+      ->capture_default_str();
   r->footer(
       "Example: ellreloc relocalize --camera camera.yaml --map map.json --detections keyframes.detections.json "
       "--method ours --out poses.txt --report report.json --threads 2");

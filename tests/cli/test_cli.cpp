@@ -92,6 +92,13 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
   EXPECT_EQ(r.code, 2);  // a voxel map has no points
   EXPECT_NE(r.err.find("needs a map with `points`"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir.path("no_points.txt")));
+  // A gravity prior for every frame (the simulated cameras look slightly down: a loose sigma).
+  r = run("relocalize --camera " + s + "/camera.yaml --map " + s + "/map_perturbed.json --detections " + s +
+              "/query/detections.json --camera-up 0,-1,0 --map-up 0,0,1 --gravity-sigma 10 --out " +
+              dir.path("gravity.txt"),
+          dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(fs::file_size(dir.path("gravity.txt")), 0u);
   r = run("--help", dir);
   EXPECT_EQ(r.code, 0);
   for (const std::string sub : {"simulate", "observe", "map", "relocalize", "evaluate", "demo"}) {
@@ -155,6 +162,10 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                                       "/keyframes.groundtruth.txt --detections " + d +
                                       "/keyframes.detections.json --out " + out},
       {"unknown preset", "simulate --preset mars --out " + dir.path("scene")},
+      {"zero gravity", reloc + "--map " + d + "/map.json --detections " + d +
+                           "/keyframes.detections.json --camera-up 0,0,0 --map-up 0,0,1"},
+      {"camera up without map up",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --camera-up 0,-1,0"},
   };
   for (const auto& [name, args] : cases) {
     const CliRun r = run(args, dir);

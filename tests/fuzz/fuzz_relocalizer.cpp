@@ -28,11 +28,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.box = o.ellipse.boundingBox();
     observations.push_back(o);
   }
+  std::optional<GravityPrior> gravity;
+  if (in.small(2) == 1)
+    gravity = GravityPrior{{num(-1, 1), num(-1, 1), num(-1, 1)}, {num(-1, 1), num(-1, 1), num(-1, 1)}, num(0.1, 10)};
   RelocalizerOptions options;
   options.ransac.max_hypotheses = 200;  // keep each run short
+  options.max_pair_hypotheses = 20;
+  options.few_object.angle_steps = 8;  // coarse sweeps: the paths matter here, not the accuracy
+  options.few_object.axis_step_deg = 60.0;
   const ObjectRelocalizer relocalizer(map, Intrinsics(525, 525, 319.5, 239.5, 640, 480), options);
-  const RelocalizationResult r = relocalizer.relocalize(observations);
+  const RelocalizationResult r = relocalizer.relocalize(observations, {}, gravity);
   FUZZ_CHECK(r.status != RelocalizationStatus::Success || r.pose.isValid());
-  FUZZ_CHECK(r.hypotheses <= options.ransac.max_hypotheses + 4);  // the budget holds
+  // The budgets hold: triplets, and up to max_poses poses per pair (or single object).
+  FUZZ_CHECK(r.hypotheses - r.few_object_hypotheses <= options.ransac.max_hypotheses + 4);
+  FUZZ_CHECK(r.few_object_hypotheses <= options.max_pair_hypotheses * options.few_object.max_poses);
   return 0;
 }
