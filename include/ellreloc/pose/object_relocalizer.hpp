@@ -85,9 +85,9 @@ struct RelocalizerOptions {
   /// off before refinement.
   double gravity_gate_deg = 15.0;
   /// Also use the gravity prior when refining poses that rest on three or more objects. On
-  /// an exact map this costs accuracy (the IMU's noise enters the pose: 0.18 -> 0.52 deg on
+  /// an exact map this costs accuracy (the IMU's noise enters the pose: 0.19 -> 0.52 deg on
   /// the synthetic room with a 1 deg IMU); on an inexact map it helps (fr2_desk with a
-  /// simulated IMU: 73.7% -> 76.3% valid). Off: objects, when there are enough, fix the tilt.
+  /// simulated IMU: 74.2% -> 77.8% valid). Off: objects, when there are enough, fix the tilt.
   bool gravity_in_every_refinement = false;
   bool correct_centres = true;  ///< re-solve P3P with the projected-centre offset removed
   /// Drop a pose at once when one of its own three pairs overlaps less than min_overlap:
