@@ -41,6 +41,7 @@ struct Match {
   int obs;
   int obj;
   double overlap;
+  double credit;  // overlap x label weight: what the match is worth in the cost
 };
 
 /// Scores poses: projects the relevant map objects and matches them to the observations.
@@ -56,6 +57,15 @@ class Scorer {
       for (int j : c) relevant[j] = 1;
     for (size_t j = 0; j < relevant.size(); ++j)
       if (relevant[j]) relevant_.push_back(static_cast<int>(j));
+    // A match to an object that carried the observed label in only a minority of its
+    // detections is worth that share of a match (full at a majority, share >= 0.5).
+    label_weight_.resize(cands_.size());
+    for (size_t i = 0; i < cands_.size(); ++i)
+      for (int j : cands_[i]) {
+        const MapObject& m = map.objects[static_cast<size_t>(j)];
+        const bool weigh = opt.weigh_minority_labels && m.category != obs[i].category;
+        label_weight_[i].push_back(weigh ? std::min(1.0, m.categoryShare(obs[i].category) / 0.5) : 1.0);
+      }
     proj_.resize(map.objects.size());
     proj_ok_.resize(map.objects.size(), 0);
     obs_used_.resize(obs.size());
@@ -75,17 +85,19 @@ class Scorer {
     for (size_t i = 0; i < obs_.size(); ++i) {
       if (!obs_valid_[i]) continue;
       const Observation& o = obs_[i];
-      for (int j : cands_[i]) {
+      for (size_t k = 0; k < cands_[i].size(); ++k) {
+        const int j = cands_[i][k];
         if (!proj_ok_[j]) continue;
         const Box pb = proj_[j].boundingBox();
         if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
         const double overlap =
             opt_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, pb) : ellipseIoU(o.ellipse, proj_[j], vertices);
-        if (overlap >= opt_.min_overlap) matches_.push_back({static_cast<int>(i), j, overlap});
+        if (overlap >= opt_.min_overlap)
+          matches_.push_back({static_cast<int>(i), j, overlap, overlap * label_weight_[i][k]});
       }
     }
     std::sort(matches_.begin(), matches_.end(), [](const Match& a, const Match& b) {
-      return a.overlap != b.overlap ? a.overlap > b.overlap : (a.obs != b.obs ? a.obs < b.obs : a.obj < b.obj);
+      return a.credit != b.credit ? a.credit > b.credit : (a.obs != b.obs ? a.obs < b.obs : a.obj < b.obj);
     });
     std::fill(obs_used_.begin(), obs_used_.end(), 0);
     std::fill(obj_used_.begin(), obj_used_.end(), 0);
@@ -95,7 +107,7 @@ class Scorer {
     for (const Match& m : matches_) {
       if (obs_used_[m.obs] || obj_used_[m.obj]) continue;
       obs_used_[m.obs] = obj_used_[m.obj] = 1;
-      total += (1.0 - m.overlap) - miss;
+      total += (1.0 - m.credit) - miss;
       if (out) out->push_back(m);
     }
     return total;
@@ -111,6 +123,7 @@ class Scorer {
   const Intrinsics& K_;
   const RelocalizerOptions& opt_;
   std::vector<int> relevant_;
+  std::vector<std::vector<double>> label_weight_;  // per observation, per candidate
   int num_valid_ = 0;
   mutable std::vector<Ellipse> proj_;
   mutable std::vector<char> proj_ok_;

@@ -406,3 +406,29 @@ TEST(ObjectRelocalizer, ScoresAGivenPose) {
   EXPECT_EQ(reloc.scorePose(s.observations, Pose(Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero())).status,
             RelocalizationStatus::InvalidInput);
 }
+
+// A match through a label the object carried in 10% of its detections is worth a fifth of one
+// through its majority label (share / 0.5), unless weigh_minority_labels is off.
+TEST(ObjectRelocalizer, MinorityLabelsWeighLess) {
+  std::mt19937 rng(105);
+  const Intrinsics K = test::testIntrinsics();
+  Synthetic s = makeScene(rng, 12, 12, 0.0);
+  while (s.observations.empty()) s = makeScene(rng, 12, 12, 0.0);
+  const std::vector<Observation> one(s.observations.begin(), s.observations.begin() + 1);
+  MapObject& object = s.map.objects[static_cast<size_t>(s.object_of[0])];
+  object.category_counts = {{object.category, 9.0}, {77, 1.0}};
+  std::vector<Observation> minority = one;
+  minority[0].category = 77;
+  const RelocalizationResult majority = ObjectRelocalizer(s.map, K).scorePose(one, s.truth);
+  const RelocalizationResult weighed = ObjectRelocalizer(s.map, K).scorePose(minority, s.truth);
+  RelocalizerOptions unweighted;
+  unweighted.weigh_minority_labels = false;
+  const RelocalizationResult plain = ObjectRelocalizer(s.map, K, unweighted).scorePose(minority, s.truth);
+  ASSERT_EQ(majority.inliers.size(), 1u);
+  ASSERT_EQ(weighed.inliers.size(), 1u);
+  const double overlap = weighed.inliers[0].overlap;  // reported unweighted
+  EXPECT_GT(overlap, 0.99);
+  EXPECT_NEAR(majority.cost, 1.0 - overlap, 1e-9);
+  EXPECT_NEAR(weighed.cost, 1.0 - 0.2 * overlap, 1e-9);
+  EXPECT_NEAR(plain.cost, 1.0 - overlap, 1e-9);
+}
