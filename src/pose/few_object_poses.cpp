@@ -45,7 +45,7 @@ std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Mat
 
 namespace {
 
-/// The refiner's object cost (Cauchy or other loss on the normalised W2^2) plus the gravity
+/// The refiner's object cost (its Cauchy loss, else the plain normalised W2^2) plus the gravity
 /// term: the sweep ranks angles by what the refinement will minimise.
 double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<EllipseMatch>& matches,
                  const std::optional<GravityPrior>& gravity, const RefinerOptions& opt) {
