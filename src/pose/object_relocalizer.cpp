@@ -248,7 +248,7 @@ struct PairEstimator {
 struct Candidates {
   std::vector<char> valid;                       // per observation
   std::vector<std::vector<int>> of_observation;  // candidate objects of each observation
-  std::vector<CandidatePair> pairs;
+  std::vector<CandidatePair> pairs;              // best (PROSAC) first
   int usable = 0;
 };
 
@@ -281,13 +281,26 @@ Candidates collectCandidates(const std::vector<Observation>& observations, const
     c.valid[i] = 1;
     ++c.usable;
   }
+  std::stable_sort(c.pairs.begin(), c.pairs.end(),
+                   [](const CandidatePair& a, const CandidatePair& b) { return a.quality > b.quality; });
   return c;
 }
 
+/// The matches of a pose as the result's correspondences, and their mean overlap.
+void reportMatches(const std::vector<Match>& matches, RelocalizationResult* result) {
+  double sum = 0.0;
+  for (const Match& m : matches) {
+    result->inliers.push_back({m.obs, m.obj, m.overlap});
+    sum += m.overlap;
+  }
+  result->mean_overlap = matches.empty() ? 0.0 : sum / matches.size();
+}
+
 /// The P3P loop: RANSAC over triplets of candidate pairs with the sampler and budgets of the
-/// options. Fills the statistics of `result`; false when no triplet gave a pose.
+/// options. Fills the statistics of `result` and the best pose's match count; false when no
+/// triplet gave a pose.
 bool searchTriplets(const PairEstimator& estimator, const RelocalizerOptions& options, size_t num_objects, int usable,
-                    Pose* best, RelocalizationResult* result) {
+                    Pose* best, int* best_inliers, RelocalizationResult* result) {
   RansacOptions ropt = options.ransac;
   // Scoring a hypothesis costs up to (map objects) x (usable observations) overlaps: a large
   // map with many observations gets fewer hypotheses, so that the worst case stays bounded.
@@ -333,6 +346,7 @@ bool searchTriplets(const PairEstimator& estimator, const RelocalizerOptions& op
   result->hypotheses = stats.hypotheses;
   result->iterations = stats.iterations;
   result->budget_exhausted = stats.budget_exhausted;
+  *best_inliers = stats.num_inliers;
   return found;
 }
 
@@ -354,12 +368,7 @@ RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>
   const Scorer scorer(observations, cands.valid, cands.of_observation, map_, K_, options_);
   std::vector<Match> matches;
   result.cost = scorer.cost(pose, 128, &matches);
-  double sum = 0.0;
-  for (const Match& m : matches) {
-    result.inliers.push_back({m.obs, m.obj, m.overlap});
-    sum += m.overlap;
-  }
-  result.mean_overlap = matches.empty() ? 0.0 : sum / matches.size();
+  reportMatches(matches, &result);
   const bool enough = static_cast<int>(matches.size()) >= std::min(options_.min_inliers, std::max(cands.usable, 1));
   result.status = enough ? RelocalizationStatus::Success : RelocalizationStatus::NoConsistentHypothesis;
   if (!enough) result.reason = "the pose explains " + std::to_string(matches.size()) + " observation(s)";
@@ -397,9 +406,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
                   "invalid gravity prior (zero or non-finite direction, or sigma not positive)");
 
   const Candidates cands = collectCandidates(observations, map_, options_, &result.skipped);
-  const std::vector<char>& valid = cands.valid;
-  const std::vector<std::vector<int>>& candidates = cands.of_observation;
-  std::vector<CandidatePair> pairs = cands.pairs;
+  const std::vector<CandidatePair>& pairs = cands.pairs;
   const int usable = cands.usable;
   // Three observations for P3P; two for the two-object solver; one with gravity.
   const bool few = options_.few_object_solvers;
@@ -409,26 +416,28 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
                   std::to_string(usable) + " usable observation(s) with a candidate object; " + std::to_string(needed) +
                       " needed" + (few && !gravity && usable == 1 ? " (or 1 with a gravity prior)" : ""));
 
-  std::stable_sort(pairs.begin(), pairs.end(),
-                   [](const CandidatePair& a, const CandidatePair& b) { return a.quality > b.quality; });
-  const Scorer scorer(observations, valid, candidates, map_, K_, options_);
+  const Scorer scorer(observations, cands.valid, cands.of_observation, map_, K_, options_);
   const PairEstimator estimator{pairs, observations, map_, K_, options_, scorer, gravity ? &*gravity : nullptr, {}};
+  const auto matchOf = [&](const auto& pair) {  // a CandidatePair or a Match
+    return EllipseMatch{observations[pair.obs].ellipse, map_.objects[pair.obj].ellipsoid};
+  };
+  const auto matchesOf = [&](const std::vector<Match>& matches) {
+    std::vector<EllipseMatch> em;
+    for (const Match& m : matches) em.push_back(matchOf(m));
+    return em;
+  };
   // The prior joins a refinement where the objects leave the tilt weakly constrained.
   const auto refinementGravity = [&](size_t matched) {
     return matched < 3 || options_.gravity_in_every_refinement ? gravity : std::nullopt;
   };
   Pose best;
   bool found = false;
-  if (usable >= 3) found = searchTriplets(estimator, options_, map_.objects.size(), usable, &best, &result);
+  int best_inliers = 0;
+  if (usable >= 3)
+    found = searchTriplets(estimator, options_, map_.objects.size(), usable, &best, &best_inliers, &result);
 
   // Few observations, or no triplet explains three: poses from pairs, or from one object and
   // gravity. They compete with the triplets' poses in the same score.
-  size_t best_inliers = 0;
-  if (found) {
-    std::vector<Match> m;
-    scorer.cost(best, kScoringIoUVertices, &m);
-    best_inliers = m.size();
-  }
   if (few && (usable <= options_.pair_search_max_observations || best_inliers < 3)) {
     const long before = result.hypotheses;
     const auto consider = [&](const std::vector<ScoredPose>& poses, const std::vector<int>& own) {
@@ -446,9 +455,6 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
         estimator.score(p.pose, &inliers);
         found = true;
       }
-    };
-    const auto matchOf = [&](const CandidatePair& c) {
-      return EllipseMatch{observations[c.obs].ellipse, map_.objects[c.obj].ellipsoid};
     };
     long tried = 0;
     for (size_t i = 0; i < pairs.size() && tried < options_.max_pair_hypotheses; ++i)
@@ -479,9 +485,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     // the observations better: a refined pose often brings more objects into overlap.
     for (int round = 0; round < options_.refine_rounds && options_.refine; ++round) {
       if (static_cast<int>(matches.size()) < (gravity ? 1 : 2)) break;
-      std::vector<EllipseMatch> em;
-      for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
-      const RefinementResult r = refinePose(K_, candidate, em, {}, options_.refiner, refinementGravity(em.size()));
+      const RefinementResult r =
+          refinePose(K_, candidate, matchesOf(matches), {}, options_.refiner, refinementGravity(matches.size()));
       if (r.fell_back || !estimator.agreesWithGravity(r.pose)) break;
       std::vector<Match> rematched;
       const double refined_cost = scorer.cost(r.pose, 128, &rematched);
@@ -503,9 +508,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   // Points pull the chosen pose towards what the overlap measure cannot see; the result is
   // kept when it still explains as many observations.
   if (!points.empty() && options_.refine && !matches.empty()) {
-    std::vector<EllipseMatch> em;
-    for (const Match& m : matches) em.push_back({observations[m.obs].ellipse, map_.objects[m.obj].ellipsoid});
-    const RefinementResult r = refinePose(K_, best, em, points, options_.refiner, refinementGravity(matches.size()));
+    const RefinementResult r =
+        refinePose(K_, best, matchesOf(matches), points, options_.refiner, refinementGravity(matches.size()));
     std::vector<Match> with_points;
     const double cost_with_points = r.fell_back ? 0.0 : scorer.cost(r.pose, 128, &with_points);
     if (!r.fell_back && with_points.size() >= matches.size() && estimator.agreesWithGravity(r.pose)) {
@@ -517,12 +521,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   }
   result.pose = best;
   result.cost = final_cost;
-  double sum = 0.0;
-  for (const Match& m : matches) {
-    result.inliers.push_back({m.obs, m.obj, m.overlap});
-    sum += m.overlap;
-  }
-  result.mean_overlap = matches.empty() ? 0.0 : sum / matches.size();
+  reportMatches(matches, &result);
   const int min_inliers = usable == 1 ? 1 : options_.min_inliers;  // a single observation needs gravity (above)
   if (static_cast<int>(matches.size()) < min_inliers)
     return finish(RelocalizationStatus::NoConsistentHypothesis, "best pose explains " + std::to_string(matches.size()) +
