@@ -36,6 +36,11 @@ inline Pose randomLookAtPose(std::mt19937& rng) {
   return Pose::lookAt(center, target);
 }
 
+/// Distance between the camera centres of two poses.
+inline double positionError(const Pose& a, const Pose& b) { return (a.center() - b.center()).norm(); }
+/// Rotation angle between two poses, in degrees.
+inline double rotationError(const Pose& a, const Pose& b) { return rotationErrorDeg(a.rotation(), b.rotation()); }
+
 inline Intrinsics testIntrinsics() { return Intrinsics(525.0, 520.0, 319.5, 239.5, 640, 480); }
 
 }  // namespace ellreloc::test

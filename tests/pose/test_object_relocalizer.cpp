@@ -7,6 +7,8 @@
 #include "ellreloc/pose/object_relocalizer.hpp"
 
 using namespace ellreloc;
+using ellreloc::test::positionError;
+using ellreloc::test::rotationError;
 using ellreloc::test::uniform;
 
 namespace {
@@ -49,7 +51,13 @@ Synthetic makeScene(std::mt19937& rng, int n, int categories, double centre_nois
   return s;
 }
 
-double positionError(const Pose& a, const Pose& b) { return (a.center() - b.center()).norm(); }
+/// makeScene, drawn again until the camera sees at least `min_observations` objects.
+Synthetic makeSceneSeeing(std::mt19937& rng, size_t min_observations, int n, int categories,
+                          double centre_noise_px = 0.0) {
+  Synthetic s = makeScene(rng, n, categories, centre_noise_px);
+  while (s.observations.size() < min_observations) s = makeScene(rng, n, categories, centre_noise_px);
+  return s;
+}
 
 }  // namespace
 
@@ -96,8 +104,7 @@ TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
 TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
   std::mt19937 rng(83);
   const Intrinsics K = test::testIntrinsics();
-  Synthetic s = makeScene(rng, 12, 6);
-  while (s.observations.size() < 5) s = makeScene(rng, 12, 6);
+  const Synthetic s = makeSceneSeeing(rng, 5, 12, 6);
   const ObjectRelocalizer reloc(s.map, K);
   // One observation without gravity; none at all; fewer than three for the OA-SLAM preset.
   const std::vector<Observation> one(s.observations.begin(), s.observations.begin() + 1);
@@ -218,8 +225,7 @@ TEST(ObjectRelocalizer, DeterministicAndThreadSafe) {
 TEST(ObjectRelocalizer, OaSlamPresetAlsoWorksOnBoxes) {
   std::mt19937 rng(85);
   const Intrinsics K = test::testIntrinsics();
-  Synthetic s = makeScene(rng, 10, 5);
-  while (s.observations.size() < 5) s = makeScene(rng, 10, 5);
+  const Synthetic s = makeSceneSeeing(rng, 5, 10, 5);
   std::vector<Observation> boxes;
   for (const Observation& o : s.observations)
     boxes.push_back(*observationFromBox(o.category, 1.0, o.ellipse.boundingBox(), K.width, K.height));
@@ -366,8 +372,7 @@ TEST(ObjectRelocalizer, OneObservationWithGravity) {
 TEST(ObjectRelocalizer, GravityPriorGatesHypotheses) {
   std::mt19937 rng(103);
   const Intrinsics K = test::testIntrinsics();
-  Synthetic s = makeScene(rng, 12, 6, 0.5);
-  while (s.observations.size() < 5) s = makeScene(rng, 12, 6, 0.5);
+  const Synthetic s = makeSceneSeeing(rng, 5, 12, 6, 0.5);
   const ObjectRelocalizer reloc(s.map, K);
   const RelocalizationResult right = reloc.relocalize(s.observations, {}, GravityPrior::atPose(s.truth));
   ASSERT_EQ(right.status, RelocalizationStatus::Success) << right.reason;
@@ -386,8 +391,7 @@ TEST(ObjectRelocalizer, GravityPriorGatesHypotheses) {
 TEST(ObjectRelocalizer, ScoresAGivenPose) {
   std::mt19937 rng(104);
   const Intrinsics K = test::testIntrinsics();
-  Synthetic s = makeScene(rng, 12, 12, 0.0);
-  while (s.observations.size() < 4) s = makeScene(rng, 12, 12, 0.0);
+  const Synthetic s = makeSceneSeeing(rng, 4, 12, 12, 0.0);
   const ObjectRelocalizer reloc(s.map, K);
   const RelocalizationResult at_truth = reloc.scorePose(s.observations, s.truth);
   EXPECT_EQ(at_truth.status, RelocalizationStatus::Success);
@@ -412,8 +416,7 @@ TEST(ObjectRelocalizer, ScoresAGivenPose) {
 TEST(ObjectRelocalizer, MinorityLabelsWeighLess) {
   std::mt19937 rng(105);
   const Intrinsics K = test::testIntrinsics();
-  Synthetic s = makeScene(rng, 12, 12, 0.0);
-  while (s.observations.empty()) s = makeScene(rng, 12, 12, 0.0);
+  Synthetic s = makeSceneSeeing(rng, 1, 12, 12, 0.0);
   const std::vector<Observation> one(s.observations.begin(), s.observations.begin() + 1);
   MapObject& object = s.map.objects[static_cast<size_t>(s.object_of[0])];
   object.category_counts = {{object.category, 9.0}, {77, 1.0}};

@@ -7,6 +7,8 @@
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
 using namespace ellreloc;
+using ellreloc::test::positionError;
+using ellreloc::test::rotationError;
 using ellreloc::test::uniform;
 
 namespace {
@@ -55,9 +57,6 @@ Pose perturb(std::mt19937& rng, const Pose& p, double deg, double metres) {
   const Eigen::Matrix3d R_wc = p.rotation().transpose() * dR;
   return Pose::fromCameraToWorld(R_wc, p.center() + metres * dir);
 }
-
-double positionError(const Pose& a, const Pose& b) { return (a.center() - b.center()).norm(); }
-double rotationError(const Pose& a, const Pose& b) { return rotationErrorDeg(a.rotation(), b.rotation()); }
 
 }  // namespace
 
