@@ -76,7 +76,8 @@ int main(int argc, char** argv) {
   camera_up->needs(map_up);
   map_up->needs(camera_up);
   r->add_option("--gravity-sigma", rl.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(camera_up);
   r->footer(
       "Example: ellreloc relocalize --camera camera.yaml --map map.json --detections keyframes.detections.json "
       "--method ours --out poses.txt --report report.json --threads 2");

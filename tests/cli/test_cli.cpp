@@ -166,6 +166,8 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                            "/keyframes.detections.json --camera-up 0,0,0 --map-up 0,0,1"},
       {"camera up without map up",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --camera-up 0,-1,0"},
+      {"gravity sigma without directions",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --gravity-sigma 5"},
   };
   for (const auto& [name, args] : cases) {
     const CliRun r = run(args, dir);
