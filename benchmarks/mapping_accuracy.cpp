@@ -172,7 +172,7 @@ int main(int argc, char** argv) {
         const auto t = f.timestamp();
         const auto k = t ? io::findNearest(gt, *t) : std::nullopt;
         if (!k) continue;
-        const io::DepthImage depth = io::readDepthPng(dir + "depth/" + f.timestampText() + ".png");
+        const DepthImage depth = io::readDepthPng(dir + "depth/" + f.timestampText() + ".png");
         const auto t0 = std::chrono::steady_clock::now();
         mapper.addKeyframe(gt[*k].pose, f.detections, &depth);
         seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -9,7 +9,7 @@
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/io/trajectory.hpp"
-#include "ellreloc/observe/observation.hpp"
+#include "ellreloc/core/observation.hpp"
 
 namespace ellreloc::bench {
 

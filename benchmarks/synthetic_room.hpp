@@ -8,7 +8,7 @@
 
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/core/projection.hpp"
-#include "ellreloc/observe/observation.hpp"
+#include "ellreloc/core/observation.hpp"
 
 namespace ellreloc::bench {
 

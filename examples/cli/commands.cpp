@@ -134,7 +134,7 @@ void map(const MapArgs& a, const Console& console) {
       ++no_pose;
       continue;
     }
-    io::DepthImage depth;
+    DepthImage depth;
     if (options.mode == MappingMode::Voxel) {
       if (!assoc) {
         ++no_depth;

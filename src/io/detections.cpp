@@ -8,24 +8,6 @@
 
 namespace ellreloc {
 
-std::string DetectionFrame::timestampText() const {
-  const size_t slash = file_name.find_last_of("/\\");
-  std::string base = slash == std::string::npos ? file_name : file_name.substr(slash + 1);
-  const size_t dot = base.find_last_of('.');
-  // "1311868164.363181.png": only the last dot starts the extension.
-  if (dot != std::string::npos && dot > 0) base = base.substr(0, dot);
-  return base;
-}
-
-std::optional<double> DetectionFrame::timestamp() const {
-  const std::string text = timestampText();
-  if (text.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double t = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size() || !std::isfinite(t)) return std::nullopt;
-  return t;
-}
-
 namespace io {
 
 namespace {

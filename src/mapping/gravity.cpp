@@ -7,7 +7,7 @@
 
 namespace ellreloc {
 
-std::optional<FloorPlane> estimateFloor(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth,
+std::optional<FloorPlane> estimateFloor(const Intrinsics& K, const Pose& pose, const DepthImage& depth,
                                         const FloorOptions& options) {
   if (!K.isValid() || !pose.isValid() || depth.width != K.width || depth.height != K.height ||
       !options.prior_up.allFinite() || !(options.prior_up.norm() > 0.0))

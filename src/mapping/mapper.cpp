@@ -49,7 +49,7 @@ Mapper::Mapper(const Intrinsics& K, const MapperOptions& options) : K_(K), optio
 }
 
 void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detections,
-                           const io::DepthImage* depth) const {
+                           const DepthImage* depth) const {
   const std::string where = keyframeText(keyframes_);
   if (!pose.isValid()) throw Error(where + ": pose is not a finite rigid transform");
   if (options_.mode == MappingMode::Voxel) {
@@ -73,7 +73,7 @@ void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detec
 }
 
 KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection>& detections,
-                                   const io::DepthImage* depth) {
+                                   const DepthImage* depth) {
   std::unique_lock lock(mutex_);
   checkKeyframe(pose, detections, depth);
   KeyframeReport report;
@@ -132,7 +132,7 @@ void Mapper::rebuild(Track& track) const {
   track.built = m;
 }
 
-void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const io::DepthImage& depth,
+void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage& depth,
                               KeyframeReport* report) {
   // The keyframe's usable detections with their masks (a box stands in for a missing mask).
   std::vector<size_t> used;

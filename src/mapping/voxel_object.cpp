@@ -20,7 +20,7 @@ bool inMask(const BinaryMask& mask, int x, int y) {
   return mask.inside(lx, ly) && mask.at(lx, ly) != 0;
 }
 
-void checkInputs(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth, const BinaryMask& mask) {
+void checkInputs(const Intrinsics& K, const Pose& pose, const DepthImage& depth, const BinaryMask& mask) {
   if (!K.isValid()) throw Error("voxel integration: invalid camera intrinsics");
   if (!pose.isValid()) throw Error("voxel integration: keyframe pose is not a finite rigid transform");
   if (depth.width != K.width || depth.height != K.height ||
@@ -49,7 +49,7 @@ BinaryMask majorityFiltered(const BinaryMask& mask) {
   return out;
 }
 
-std::pair<double, double> VoxelObject::depthGate(const io::DepthImage& depth, const BinaryMask& mask,
+std::pair<double, double> VoxelObject::depthGate(const DepthImage& depth, const BinaryMask& mask,
                                                  int stride) const {
   std::pair<double, double> range(options_.min_depth, options_.max_depth);
   if (!(options_.depth_gate_sigmas > 0.0)) return range;
@@ -96,7 +96,7 @@ bool VoxelObject::occupied(const Voxel& v) const {
   return v.log_odds >= static_cast<float>(logit(options_.occupied_probability));
 }
 
-VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth,
+VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const DepthImage& depth,
                                    const BinaryMask& raw_mask) {
   checkInputs(K, pose, depth, raw_mask);
   const BinaryMask filtered = options_.mask_majority_filter ? majorityFiltered(raw_mask) : BinaryMask();

@@ -188,10 +188,6 @@ RegularVerdict testRegularMask(const RleMask& rle, const RegularMaskOptions& opt
   return v;
 }
 
-RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions& options) {
-  return testRegularMask(encodeMask(mask), options);
-}
-
 std::vector<Eigen::Vector2d> rleOutline(const RleMask& rle, bool* touches_border) {
   std::vector<Eigen::Vector2d> pts;
   const std::vector<MaskColumn> cols = rleColumns(rle);

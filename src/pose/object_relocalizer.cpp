@@ -7,7 +7,7 @@
 
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
-#include "ellreloc/pose/p3p.hpp"
+#include "ellreloc/core/p3p.hpp"
 
 namespace ellreloc {
 

@@ -5,7 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "draw.hpp"
-#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/core/mask.hpp"
 
 namespace ellreloc::sim {
 
@@ -169,8 +169,8 @@ std::vector<Keypoint> keypoints(const Scene& scene, const RenderedFrame& frame, 
   return out;
 }
 
-io::DepthImage noisyDepth(const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng) {
-  io::DepthImage d;
+DepthImage noisyDepth(const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng) {
+  DepthImage d;
   d.width = frame.width;
   d.height = frame.height;
   d.metres = frame.depth;

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "ellreloc/core.hpp"
-#include "ellreloc/pose/p3p.hpp"
+#include "ellreloc/core/p3p.hpp"
 #include "fuzz_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,10 +1,10 @@
 // COCO RLE decoding and everything that walks the runs: moments, the regular-mask test, fits.
 #include <string>
 
-#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/core/mask.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/observe/regular_mask.hpp"
-#include "ellreloc/observe/rle.hpp"
+#include "ellreloc/core/rle.hpp"
 #include "fuzz_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -7,7 +7,7 @@
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/map.hpp"
-#include "ellreloc/observe/rle.hpp"
+#include "ellreloc/core/rle.hpp"
 
 namespace ellreloc {
 namespace {

@@ -19,7 +19,7 @@ TEST(RgbdIo, ReadsTheFr3CabinetAssociationsAndDepth) {
     EXPECT_TRUE(std::filesystem::exists(a.rgb_path)) << a.rgb_path;
     EXPECT_TRUE(std::filesystem::exists(a.depth_path)) << a.depth_path;
   }
-  const io::DepthImage d = io::readDepthPng(assoc[0].depth_path);
+  const DepthImage d = io::readDepthPng(assoc[0].depth_path);
   EXPECT_EQ(d.width, 640);
   EXPECT_EQ(d.height, 480);
   // Independent check: the raw 16-bit values through OpenCV, divided by 5000.
@@ -35,12 +35,12 @@ TEST(RgbdIo, ReadsTheFr3CabinetAssociationsAndDepth) {
 
 TEST(RgbdIo, DepthRoundTripAndErrors) {
   test::TempDir dir;
-  io::DepthImage d;
+  DepthImage d;
   d.width = 4;
   d.height = 3;
   d.metres = {0.0f, 0.5f, 1.0002f, 2.5f, 13.107f, 20.0f, -1.0f, 0.0002f, 3.3f, 1.0f, 1.0f, 1.0f};
   io::writeDepthPng(dir.path("d.png"), d);
-  const io::DepthImage back = io::readDepthPng(dir.path("d.png"));
+  const DepthImage back = io::readDepthPng(dir.path("d.png"));
   ASSERT_EQ(back.metres.size(), d.metres.size());
   EXPECT_FLOAT_EQ(back.at(1, 0), 0.5f);
   EXPECT_FLOAT_EQ(back.at(2, 0), 1.0002f);
@@ -59,7 +59,7 @@ TEST(RgbdIo, DepthRoundTripAndErrors) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("16-bit"), std::string::npos);
   }
-  io::DepthImage bad = d;
+  DepthImage bad = d;
   bad.metres.pop_back();
   EXPECT_THROW(io::writeDepthPng(dir.path("bad.png"), bad), Error);
   EXPECT_FALSE(std::filesystem::exists(dir.path("bad.png")));

@@ -16,7 +16,7 @@ namespace ellreloc::test {
 
 struct SimKeyframe {
   Pose pose;
-  io::DepthImage depth;
+  DepthImage depth;
   std::vector<Detection> detections;  // object_id = index into scene.objects
 };
 

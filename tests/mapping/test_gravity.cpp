@@ -35,13 +35,13 @@ TEST(Floor, FindsTheFloorNormalInARenderedFrameInAnyWorldFrame) {
 
 TEST(Floor, NoFloorNoAnswer) {
   const Intrinsics K(500, 500, 319.5, 239.5, 640, 480);
-  io::DepthImage wall;
+  DepthImage wall;
   wall.width = 640;
   wall.height = 480;
   wall.metres.assign(640 * 480, 2.0f);  // a wall straight ahead of a horizontal camera
   const Pose camera = Pose::lookAt(Eigen::Vector3d(0, 0, 1.5), Eigen::Vector3d(0, 5, 1.5));
   EXPECT_FALSE(estimateFloor(K, camera, wall));
-  io::DepthImage empty = wall;
+  DepthImage empty = wall;
   std::fill(empty.metres.begin(), empty.metres.end(), 0.0f);
   EXPECT_FALSE(estimateFloor(K, camera, empty));
   // Looking along world z the same depth is a floor, one wall's depth away (2 m).
@@ -49,7 +49,7 @@ TEST(Floor, NoFloorNoAnswer) {
   ASSERT_TRUE(plane);
   EXPECT_NEAR(plane->offset, 2.0, 1e-4);
   EXPECT_NEAR(plane->inlier_share, 1.0, 1e-9);
-  io::DepthImage small = wall;
+  DepthImage small = wall;
   small.width = 320;
   EXPECT_FALSE(estimateFloor(K, camera, small));
 }

@@ -107,7 +107,7 @@ TEST(Mapper, AnObjectLeavingAndReenteringTheViewIsFoundAgainIn3D) {
   for (size_t i = 0; i < poses.size(); ++i) {
     const sim::RenderedFrame frame = sim::render(scene, K, poses[i]);
     const auto detections = sim::detect(scene, frame, sim::NoiseModel(), rng);
-    const io::DepthImage depth = sim::noisyDepth(frame, sim::NoiseModel(), rng);
+    const DepthImage depth = sim::noisyDepth(frame, sim::NoiseModel(), rng);
     if (i >= 4 && i < 8) {
       EXPECT_TRUE(detections.empty());
     }
@@ -153,11 +153,11 @@ TEST(Mapper, BadKeyframesAreErrorsAndLeaveTheMapUnchanged) {
   mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
   const MapperStats before = mapper.stats();
 
-  io::DepthImage zeros = kf.depth;
+  DepthImage zeros = kf.depth;
   std::fill(zeros.metres.begin(), zeros.metres.end(), 0.0f);
   EXPECT_THROW(mapper.addKeyframe(kf.pose, kf.detections, &zeros), Error);
   EXPECT_THROW(mapper.addKeyframe(kf.pose, kf.detections, nullptr), Error);
-  io::DepthImage small = kf.depth;
+  DepthImage small = kf.depth;
   small.width = 320;
   EXPECT_THROW(mapper.addKeyframe(kf.pose, kf.detections, &small), Error);
   const double nan = std::nan("");

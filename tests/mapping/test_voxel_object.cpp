@@ -11,8 +11,8 @@ namespace {
 
 const Intrinsics kK(500.0, 500.0, 319.5, 239.5, 640, 480);
 
-io::DepthImage flatDepth(float metres) {
-  io::DepthImage d;
+DepthImage flatDepth(float metres) {
+  DepthImage d;
   d.width = kK.width;
   d.height = kK.height;
   d.metres.assign(static_cast<size_t>(d.width) * d.height, metres);
@@ -100,7 +100,7 @@ TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {
 }
 
 TEST(VoxelObject, DepthGateDropsMaskPixelsOnTheBackground) {
-  io::DepthImage depth = flatDepth(2.005f);
+  DepthImage depth = flatDepth(2.005f);
   for (int y = 0; y < kK.height; ++y)
     for (int x = 0; x < 310; ++x) depth.metres[static_cast<size_t>(y) * kK.width + x] = 4.0f;  // a wall behind
   VoxelObject v;
@@ -158,11 +158,11 @@ TEST(VoxelObject, BadInputIsAnErrorNotACrash) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(v.integrate(kK, Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0)), flatDepth(2.005f), mask),
                Error);
-  io::DepthImage small = flatDepth(2.005f);
+  DepthImage small = flatDepth(2.005f);
   small.width = 320;
   EXPECT_THROW(v.integrate(kK, Pose(), small, mask), Error);
   EXPECT_EQ(v.size(), 0u);
-  io::DepthImage nan_depth = flatDepth(std::numeric_limits<float>::quiet_NaN());
+  DepthImage nan_depth = flatDepth(std::numeric_limits<float>::quiet_NaN());
   EXPECT_EQ(v.integrate(kK, Pose(), nan_depth, mask).hits, 0);
 }
 

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "ellreloc/core/ellipse.hpp"
-#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/core/mask.hpp"
 
 namespace ellreloc::test {
 

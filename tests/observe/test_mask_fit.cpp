@@ -8,7 +8,8 @@
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
-#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/core/mask.hpp"
+#include "mask_outline.hpp"
 #include "mask_shapes.hpp"
 
 using namespace ellreloc;
@@ -95,7 +96,7 @@ TEST(EllipseFit, OutlineDropsTheImageBorderSoTruncatedObjectsFitWell) {
   const Ellipse e({-10, 100}, {60, 35}, 0.2);
   const BinaryMask m = test::rasterEllipse(e, 200, 200);
   bool border = false;
-  const auto pts = maskOutline(m, &border);
+  const auto pts = test::maskOutline(m, &border);
   EXPECT_TRUE(border);
   for (const auto& p : pts) EXPECT_GE(p(0), 0.0);  // nothing on the border line x = -0.5
   const auto direct = fitEllipseDirect(pts);
@@ -158,7 +159,7 @@ TEST(EllipseFit, RealMasksAgreeWithOpenCvFitEllipse) {
       std::vector<cv::Point> all;
       for (const auto& c : contours) all.insert(all.end(), c.begin(), c.end());
       const cv::RotatedRect cvfit = cv::fitEllipse(all);
-      const auto ours = fitEllipseDirect(maskOutline(m));
+      const auto ours = fitEllipseDirect(test::maskOutline(m));
       ASSERT_TRUE(ours.has_value());
       const double size = std::sqrt(ours->axes().prod());
       EXPECT_LT((ours->center() - Eigen::Vector2d(cvfit.center.x, cvfit.center.y)).norm(), 0.1 * size + 3.0)
@@ -178,7 +179,7 @@ TEST(Mask, CropDecodingMatchesFullDecoding) {
       const BinaryMask crop = *decodeMaskCrop(*det.mask);
       EXPECT_EQ(crop.count(), full.count());
       EXPECT_EQ(encodeMask(crop).counts, det.mask->counts);
-      EXPECT_EQ(maskOutline(crop), maskOutline(full));
+      EXPECT_EQ(test::maskOutline(crop), test::maskOutline(full));
       EXPECT_DOUBLE_EQ(crop.x0 - 0.5, det.bbox.x1);
       EXPECT_DOUBLE_EQ(crop.y0 + crop.height - 0.5, det.bbox.y2);
     }

@@ -104,7 +104,7 @@ TEST(RegularMask, LabelledSetIsClassifiedAt95Percent) {
   std::map<std::string, std::pair<int, int>> per_kind;  // correct, total
   auto check = [&](const std::string& kind, BinaryMask m, bool regular) {
     test::addBoundaryNoise(m, rng, 0.3);
-    const RegularVerdict v = testRegularMask(m);
+    const RegularVerdict v = testRegularMask(encodeMask(m));
     const bool ok = v.regular == regular;
     correct += ok;
     ++total;
@@ -133,7 +133,7 @@ TEST(RegularMask, LabelledSetIsClassifiedAt95Percent) {
 
 TEST(RegularMask, DiagnosticsOfARectangle) {
   const BinaryMask m = test::rasterPolygon({{50, 40}, {150, 40}, {150, 100}, {50, 100}}, 200, 200);
-  const RegularVerdict v = testRegularMask(m);
+  const RegularVerdict v = testRegularMask(encodeMask(m));
   EXPECT_TRUE(v.regular);
   EXPECT_EQ(v.quad_vertices, 4);
   EXPECT_NEAR(v.fill, 1.0, 0.02);
@@ -160,7 +160,7 @@ TEST(RegularMask, RealLabelmeMasks) {
   const auto frames = io::readDetections(test::dataPath("labelme_masks/detections.json"));
   std::vector<bool> verdicts;
   for (const auto& f : frames)
-    for (const auto& d : f.detections) verdicts.push_back(testRegularMask(*decodeMask(*d.mask)).regular);
+    for (const auto& d : f.detections) verdicts.push_back(testRegularMask(*d.mask).regular);
   EXPECT_EQ(verdicts, expected);
 }
 

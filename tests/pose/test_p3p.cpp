@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "ellreloc/pose/p3p.hpp"
+#include "ellreloc/core/p3p.hpp"
 #include "p3p_problems.hpp"
 
 using namespace ellreloc;

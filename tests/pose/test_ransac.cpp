@@ -3,8 +3,8 @@
 #include <Eigen/Geometry>
 #include <set>
 
-#include "ellreloc/pose/p3p.hpp"
-#include "ellreloc/pose/ransac.hpp"
+#include "ellreloc/core/p3p.hpp"
+#include "ellreloc/core/ransac.hpp"
 
 using namespace ellreloc;
 

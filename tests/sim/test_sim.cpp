@@ -4,7 +4,7 @@
 
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
-#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/core/mask.hpp"
 #include "ellreloc/sim/render.hpp"
 #include "ellreloc/sim/scene.hpp"
 

@@ -33,7 +33,7 @@ TEST(Noise, NoneGivesTheRenderedTruth) {
     EXPECT_EQ(d.bbox.x1, f.boxes[j].x1);
     EXPECT_EQ(d.bbox.y2, f.boxes[j].y2);
   }
-  const io::DepthImage depth = noisyDepth(f, NoiseModel::preset(NoiseLevel::None), rng);
+  const DepthImage depth = noisyDepth(f, NoiseModel::preset(NoiseLevel::None), rng);
   EXPECT_EQ(depth.metres, f.depth);
 }
 
@@ -93,7 +93,7 @@ TEST(Writer, WritesTheTumLayoutDeterministically) {
   EXPECT_FALSE(truth.points.empty());
   const auto assoc = io::readAssociations(dir + "mapping/associations.txt");
   ASSERT_EQ(assoc.size(), 4u);
-  const io::DepthImage depth = io::readDepthPng(assoc[0].depth_path);
+  const DepthImage depth = io::readDepthPng(assoc[0].depth_path);
   EXPECT_EQ(depth.width, K.width);
   EXPECT_TRUE(std::filesystem::exists(assoc[0].rgb_path));
   EXPECT_EQ(io::readTumTrajectory(dir + "mapping/trajectory.txt").size(), 4u);

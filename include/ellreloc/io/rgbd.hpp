@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "ellreloc/core/depth_image.hpp"
+
 namespace ellreloc::io {
 
 struct Association {
@@ -18,14 +20,6 @@ struct Association {
 /// Reads an association file; relative paths are made relative to the file's own folder.
 /// `#` starts a comment. Throws ellreloc::Error naming the file and line on malformed input.
 std::vector<Association> readAssociations(const std::string& path);
-
-/// A depth image in metres, row-major; 0 where there is no reading.
-struct DepthImage {
-  int width = 0;
-  int height = 0;
-  std::vector<float> metres;
-  float at(int x, int y) const { return metres[static_cast<size_t>(y) * width + x]; }
-};
 
 /// TUM's scale: 5000 depth units per metre.
 constexpr double kTumDepthUnitsPerMetre = 5000.0;

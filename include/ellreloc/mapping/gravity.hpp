@@ -10,7 +10,7 @@
 #include <optional>
 
 #include "ellreloc/core/camera.hpp"
-#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/core/depth_image.hpp"
 
 namespace ellreloc {
 
@@ -32,7 +32,7 @@ struct FloorPlane {
 
 /// The floor (or a plane parallel to it) seen by a keyframe with world->camera `pose`;
 /// nullopt when no plane within max_tilt_deg of the prior holds min_inlier_share of the pixels.
-std::optional<FloorPlane> estimateFloor(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth,
+std::optional<FloorPlane> estimateFloor(const Intrinsics& K, const Pose& pose, const DepthImage& depth,
                                         const FloorOptions& options = {});
 
 }  // namespace ellreloc

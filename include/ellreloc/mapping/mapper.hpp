@@ -21,8 +21,8 @@
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/object_map.hpp"
-#include "ellreloc/io/detections.hpp"
-#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/depth_image.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
 #include "ellreloc/mapping/ellipsoid_builder.hpp"
 #include "ellreloc/mapping/gravity.hpp"
@@ -97,7 +97,7 @@ class Mapper {
   /// problem for a non-finite pose, a missing, mis-sized or empty depth image, or a mask whose
   /// size differs from the camera's; the map is then left unchanged.
   KeyframeReport addKeyframe(const Pose& pose, const std::vector<Detection>& detections,
-                             const io::DepthImage* depth = nullptr);
+                             const DepthImage* depth = nullptr);
 
   /// The objects in the map (those with an ellipsoid), in the order they were created.
   ObjectMap map() const;
@@ -118,8 +118,8 @@ class Mapper {
     std::optional<MappedObject> built;  // rebuilt after each update of a confirmed object
     int label() const;
   };
-  void checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const io::DepthImage* depth) const;
-  void addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const io::DepthImage& depth,
+  void checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const;
+  void addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage& depth,
                         KeyframeReport* report);
   void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report);
   void observed(Track& track, const Detection& detection);

@@ -19,8 +19,8 @@
 
 #include "ellreloc/core/box.hpp"
 #include "ellreloc/core/camera.hpp"
-#include "ellreloc/io/rgbd.hpp"
-#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/core/depth_image.hpp"
+#include "ellreloc/core/mask.hpp"
 
 namespace ellreloc {
 
@@ -66,7 +66,7 @@ class VoxelObject {
   /// Integrates one keyframe: world->camera `pose`, its depth image, and the object's mask in
   /// that image (a full-image mask or a crop). Throws ellreloc::Error when the intrinsics,
   /// pose, depth or mask are invalid or their sizes differ.
-  VoxelUpdate integrate(const Intrinsics& K, const Pose& pose, const io::DepthImage& depth, const BinaryMask& mask);
+  VoxelUpdate integrate(const Intrinsics& K, const Pose& pose, const DepthImage& depth, const BinaryMask& mask);
 
   /// Removes voxels whose probability is below `probability` (the paper's stage-by-stage filter).
   size_t prune(double probability);
@@ -107,7 +107,7 @@ class VoxelObject {
   bool occupied(const Voxel& v) const;
   void enforceBudget();
   /// The [near, far] depths of the mask's hits (the depth gate).
-  std::pair<double, double> depthGate(const io::DepthImage& depth, const BinaryMask& mask, int stride) const;
+  std::pair<double, double> depthGate(const DepthImage& depth, const BinaryMask& mask, int stride) const;
 
   struct KeyHash {
     size_t operator()(uint64_t k) const {  // splitmix64 finaliser: packed keys are far from random

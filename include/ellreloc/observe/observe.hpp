@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
-#include "ellreloc/io/detections.hpp"
-#include "ellreloc/observe/observation.hpp"
+#include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/observation.hpp"
 #include "ellreloc/observe/regular_mask.hpp"
 
 namespace ellreloc {

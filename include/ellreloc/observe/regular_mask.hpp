@@ -10,7 +10,7 @@
 #include <array>
 #include <vector>
 
-#include "ellreloc/observe/mask.hpp"
+#include "ellreloc/core/mask.hpp"
 
 namespace ellreloc {
 
@@ -46,7 +46,6 @@ struct RegularVerdict {
 /// each column's extreme rows, O(runs + columns). An empty or inconsistent mask is not
 /// regular (all diagnostics 0).
 RegularVerdict testRegularMask(const RleMask& mask, const RegularMaskOptions& options = {});
-RegularVerdict testRegularMask(const BinaryMask& mask, const RegularMaskOptions& options = {});
 
 /// The rows a mask covers in one image column.
 struct MaskColumn {

@@ -26,11 +26,11 @@
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/object_map.hpp"
-#include "ellreloc/io/detections.hpp"
-#include "ellreloc/observe/observation.hpp"
+#include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/observation.hpp"
 #include "ellreloc/pose/few_object_poses.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
-#include "ellreloc/pose/ransac.hpp"
+#include "ellreloc/core/ransac.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
 namespace ellreloc {

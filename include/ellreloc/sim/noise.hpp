@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "ellreloc/core/object_map.hpp"
-#include "ellreloc/io/detections.hpp"
-#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/depth_image.hpp"
 #include "ellreloc/sim/render.hpp"
 #include "ellreloc/sim/scene.hpp"
 
@@ -53,7 +53,7 @@ std::vector<Keypoint> keypoints(const Scene& scene, const RenderedFrame& frame, 
                                 const NoiseModel& noise, std::mt19937_64& rng);
 
 /// The frame's depth in metres with noise (sigma growing with depth^2); 0 stays 0.
-io::DepthImage noisyDepth(const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng);
+DepthImage noisyDepth(const RenderedFrame& frame, const NoiseModel& noise, std::mt19937_64& rng);
 
 /// The ground-truth map with a mapper's errors (centre, axes, yaw; rotations stay yaw-only).
 ObjectMap perturbMap(const ObjectMap& map, const NoiseModel& noise, uint64_t seed);

@@ -9,7 +9,7 @@
 
 #include "ellreloc/core/box.hpp"
 #include "ellreloc/core/camera.hpp"
-#include "ellreloc/observe/rle.hpp"
+#include "ellreloc/core/rle.hpp"
 #include "ellreloc/sim/scene.hpp"
 
 namespace ellreloc::sim {
