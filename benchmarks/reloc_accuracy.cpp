@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
       "hyp/query |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   RelocalizerOptions unrefined;
-  unrefined.refine = false;
+  unrefined.refinement.enabled = false;
   for (const auto& d :
        {fr2, syntheticRoom(false, 11), syntheticRoom(true, 12), simulated(sim::ScenePreset::Office, 200, 31),
         simulated(sim::ScenePreset::Cluttered, 200, 32)}) {
@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
     evaluate("ours + gravity (1 deg)", d, RelocalizerOptions(), true);
     if (d.name.rfind("fr2", 0) == 0) {
       RelocalizerOptions every;
-      every.gravity_in_every_refinement = true;
+      every.gravity.in_every_refinement = true;
       evaluate("ours + gravity, every refinement", d, every, true);
     }
     if (ours_only) continue;

@@ -32,15 +32,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (in.small(2) == 1)
     gravity = GravityPrior{{num(-1, 1), num(-1, 1), num(-1, 1)}, {num(-1, 1), num(-1, 1), num(-1, 1)}, num(0.1, 10)};
   RelocalizerOptions options;
-  options.ransac.max_hypotheses = 200;  // keep each run short
-  options.max_pair_hypotheses = 20;
-  options.few_object.angle_steps = 8;  // coarse sweeps: the paths matter here, not the accuracy
-  options.few_object.axis_step_deg = 60.0;
+  options.search.budget.max_hypotheses = 200;  // keep each run short
+  options.few_objects.max_pair_hypotheses = 20;
+  options.few_objects.solver.angle_steps = 8;  // coarse sweeps: the paths matter here, not the accuracy
+  options.few_objects.solver.axis_step_deg = 60.0;
   const ObjectRelocalizer relocalizer(map, Intrinsics(525, 525, 319.5, 239.5, 640, 480), options);
   const RelocalizationResult r = relocalizer.relocalize(observations, {}, gravity);
   FUZZ_CHECK(r.status != RelocalizationStatus::Success || r.pose.isValid());
   // The budgets hold: triplets, and up to max_poses poses per pair (or single object).
-  FUZZ_CHECK(r.hypotheses - r.few_object_hypotheses <= options.ransac.max_hypotheses + 4);
-  FUZZ_CHECK(r.few_object_hypotheses <= options.max_pair_hypotheses * options.few_object.max_poses);
+  FUZZ_CHECK(r.hypotheses - r.few_object_hypotheses <= options.search.budget.max_hypotheses + 4);
+  FUZZ_CHECK(r.few_object_hypotheses <= options.few_objects.max_pair_hypotheses * options.few_objects.solver.max_poses);
   return 0;
 }

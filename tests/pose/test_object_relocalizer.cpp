@@ -92,9 +92,9 @@ TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
     if (s.observations.size() < 5) continue;
     ++tried;
     RelocalizerOptions opt;
-    opt.ransac.seed = trial;
+    opt.search.budget.seed = trial;
     const RelocalizationResult r = ObjectRelocalizer(s.map, K, opt).relocalize(s.observations);
-    EXPECT_LE(r.hypotheses, opt.ransac.max_hypotheses + 4);
+    EXPECT_LE(r.hypotheses, opt.search.budget.max_hypotheses + 4);
     recovered += r.status == RelocalizationStatus::Success && positionError(r.pose, s.truth) < 0.05;
   }
   EXPECT_GE(tried, 4);
@@ -159,20 +159,20 @@ TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
   }
   s.observations.resize(50);
   RelocalizerOptions hypotheses_only;
-  hypotheses_only.ransac.max_hypotheses = 300;
+  hypotheses_only.search.budget.max_hypotheses = 300;
   const RelocalizationResult a = ObjectRelocalizer(s.map, K, hypotheses_only).relocalize(s.observations);
   EXPECT_LE(a.hypotheses, 300 + 4);  // the last triplet's P3P solutions may finish
   EXPECT_TRUE(a.budget_exhausted);
   RelocalizerOptions work_only;  // the machine-independent bound: 3e6 overlaps = 300 hypotheses here
-  work_only.max_overlap_evaluations = 200L * 50 * 300;
-  work_only.min_hypotheses_budget = 10;
+  work_only.search.max_overlap_evaluations = 200L * 50 * 300;
+  work_only.search.min_hypotheses = 10;
   const RelocalizationResult w = ObjectRelocalizer(s.map, K, work_only).relocalize(s.observations);
   EXPECT_LE(w.hypotheses, 300 + 4);
   EXPECT_TRUE(w.budget_exhausted);
   RelocalizerOptions time_only;
-  time_only.max_overlap_evaluations = 0;
-  time_only.ransac.max_hypotheses = 1L << 40;
-  time_only.ransac.max_time_ms = 1.0;
+  time_only.search.max_overlap_evaluations = 0;
+  time_only.search.budget.max_hypotheses = 1L << 40;
+  time_only.search.budget.max_time_ms = 1.0;
   const RelocalizationResult b = ObjectRelocalizer(s.map, K, time_only).relocalize(s.observations);
   EXPECT_TRUE(b.budget_exhausted);  // stopped by the clock, not by running out of triplets
   EXPECT_LT(b.hypotheses, 1L << 30);
@@ -382,7 +382,7 @@ TEST(ObjectRelocalizer, GravityPriorGatesHypotheses) {
   wrong.up_in_camera = s.truth.rotation() * Eigen::Vector3d::UnitX();
   const RelocalizationResult r = reloc.relocalize(s.observations, {}, wrong);
   if (r.status == RelocalizationStatus::Success) {
-    EXPECT_LE(wrong.errorDeg(r.pose), reloc.options().gravity_gate_deg + 1e-9);
+    EXPECT_LE(wrong.errorDeg(r.pose), reloc.options().gravity.gate_deg + 1e-9);
     EXPECT_GT(positionError(r.pose, s.truth), 0.05);
   }
 }
@@ -406,7 +406,7 @@ TEST(ObjectRelocalizer, ScoresAGivenPose) {
   const RelocalizationResult r = reloc.scorePose(s.observations, away);
   EXPECT_EQ(r.status, RelocalizationStatus::NoConsistentHypothesis);
   EXPECT_TRUE(r.inliers.empty());
-  EXPECT_DOUBLE_EQ(r.cost, reloc.options().unmatched_cost * s.observations.size());
+  EXPECT_DOUBLE_EQ(r.cost, reloc.options().scoring.unmatched_cost * s.observations.size());
   EXPECT_EQ(reloc.scorePose(s.observations, Pose(Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero())).status,
             RelocalizationStatus::InvalidInput);
 }
@@ -425,7 +425,7 @@ TEST(ObjectRelocalizer, MinorityLabelsWeighLess) {
   const RelocalizationResult majority = ObjectRelocalizer(s.map, K).scorePose(one, s.truth);
   const RelocalizationResult weighed = ObjectRelocalizer(s.map, K).scorePose(minority, s.truth);
   RelocalizerOptions unweighted;
-  unweighted.weigh_minority_labels = false;
+  unweighted.scoring.weigh_minority_labels = false;
   const RelocalizationResult plain = ObjectRelocalizer(s.map, K, unweighted).scorePose(minority, s.truth);
   ASSERT_EQ(majority.inliers.size(), 1u);
   ASSERT_EQ(weighed.inliers.size(), 1u);

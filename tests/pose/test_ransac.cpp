@@ -48,7 +48,6 @@ struct PnPEstimator {
   static constexpr int kMaxModels = 4;
   const PnPProblem* problem;
   double threshold_rad = 2e-3;
-  mutable int refine_calls = 0;
 
   size_t numData() const { return problem->points.size(); }
   int generate(const int* s, Model* models) const {
@@ -70,7 +69,6 @@ struct PnPEstimator {
     }
     return cost;
   }
-  void refine(Model*) const { ++refine_calls; }
 };
 
 double rotationErrorOf(const Pose& a, const Pose& b) { return rotationErrorDeg(a.rotation(), b.rotation()); }
@@ -84,12 +82,16 @@ TEST(Ransac, SolvesPnPWithOutliers) {
     UniformSampler sampler(100, 3, seed);
     Pose best;
     RansacStats stats;
-    ASSERT_TRUE(ransac(est, sampler, RansacOptions{}, &best, &stats));
+    long observed = 0;
+    double lowest = 1e300;
+    const auto observer = [&](const Pose&, double score, int) { ++observed, lowest = std::min(lowest, score); };
+    ASSERT_TRUE(ransac(est, sampler, RansacOptions{}, &best, &stats, observer));
     EXPECT_LT(rotationErrorOf(best, p.truth), 0.1);
     EXPECT_LT((best.center() - p.truth.center()).norm(), 0.02);
     EXPECT_GE(stats.num_inliers, 48);
     EXPECT_LE(stats.num_inliers, 52);
-    EXPECT_EQ(est.refine_calls, 1);
+    EXPECT_EQ(observed, stats.hypotheses);  // the observer sees every scored model
+    EXPECT_EQ(lowest, stats.score);
     EXPECT_FALSE(stats.budget_exhausted);
     // The adaptive count stops far below the cap for 50% inliers (~70 samples at p = 0.9999).
     EXPECT_LT(stats.iterations, 200);

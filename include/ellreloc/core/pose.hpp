@@ -1,6 +1,7 @@
 #pragma once
 /// \file pose.hpp
-/// A camera pose (world->camera rigid transform) and the rotation error between two poses.
+/// A camera pose (world->camera rigid transform), a pose with a cost, and the rotation error
+/// between two poses.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -62,6 +63,12 @@ class Pose {
  private:
   Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t_ = Eigen::Vector3d::Zero();
+};
+
+/// A pose with the cost that ranked it (lower is better): a solver's or a score's.
+struct ScoredPose {
+  Pose pose;
+  double cost = 0.0;
 };
 
 /// Rotation angle of R_a^T R_b in degrees (the rotation error of FORMATS.md).

@@ -2,7 +2,9 @@
 /// \file ransac.hpp
 /// A generic RANSAC engine (header-only) over a duck-typed estimator, with pluggable samplers
 /// (exhaustive enumeration, uniform random, PROSAC), MSAC-style scoring, an adaptive iteration
-/// count with clamps, an explicit seed, hypothesis and time budgets, and statistics.
+/// count with clamps, an explicit seed, hypothesis and time budgets, and statistics. An
+/// optional observer sees every scored model (the relocalizer keeps its best few that way and
+/// refines them after the loop).
 ///
 /// An Estimator provides:
 ///   using Model = ...;                       // a hypothesis
@@ -11,7 +13,6 @@
 ///   size_t numData() const;
 ///   int generate(const int* sample, Model* models) const;      // fills up to kMaxModels
 ///   double score(const Model& m, int* num_inliers) const;       // MSAC cost: lower is better
-///   void refine(Model* m) const;                                // e.g. least squares on inliers
 /// A sample the estimator cannot use (e.g. repeated observations) simply generates 0 models.
 
 #include <algorithm>
@@ -32,8 +33,6 @@ struct RansacOptions {
   double max_time_ms = 0.0;             ///< wall-clock budget; 0 = none
   double success_probability = 0.9999;  ///< for the adaptive iteration count
   uint64_t seed = 0;                    ///< same input + seed = same output
-  bool refine = true;                   ///< call Estimator::refine on the best model
-  int stop_at_inliers = 0;              ///< stop as soon as a model has this many inliers; 0 = never
 };
 
 struct RansacStats {
@@ -157,10 +156,17 @@ inline int adaptiveIterations(double inlier_ratio, int sample_size, double succe
   return k > 1e9 ? std::numeric_limits<int>::max() : static_cast<int>(std::ceil(k));
 }
 
+/// An observer that ignores every scored model.
+struct IgnoreScoredModels {
+  template <typename Model>
+  void operator()(const Model&, double /*score*/, int /*num_inliers*/) const {}
+};
+
 /// Runs RANSAC. `best` receives the best model; returns false when no model was generated.
-template <typename Estimator, typename Sampler>
+/// `observer(model, score, num_inliers)` is called for every scored model, in order.
+template <typename Estimator, typename Sampler, typename Observer = IgnoreScoredModels>
 bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& options, typename Estimator::Model* best,
-            RansacStats* stats) {
+            RansacStats* stats, Observer&& observer = Observer{}) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   RansacStats st;
@@ -175,7 +181,6 @@ bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& o
       break;
     }
     if (st.iterations >= std::max(options.min_iterations, needed)) break;
-    if (have && needed == 0 && options.stop_at_inliers > 0 && st.num_inliers >= options.stop_at_inliers) break;
     if (options.max_time_ms > 0.0 && (st.iterations & 7) == 0 &&
         std::chrono::duration<double, std::milli>(Clock::now() - start).count() > options.max_time_ms) {
       st.budget_exhausted = true;
@@ -191,6 +196,7 @@ bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& o
       ++st.hypotheses;
       int inliers = 0;
       const double score = estimator.score(models[i], &inliers);
+      observer(models[i], score, inliers);
       if (score < st.score) {
         st.score = score;
         st.num_inliers = inliers;
@@ -199,19 +205,7 @@ bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& o
         have = true;
         needed = adaptiveIterations(n ? static_cast<double>(inliers) / n : 0.0, Estimator::kSampleSize,
                                     options.success_probability);
-        if (options.stop_at_inliers > 0 && inliers >= options.stop_at_inliers) needed = 0;
       }
-    }
-  }
-  if (have && options.refine) {
-    typename Estimator::Model refined = *best;
-    estimator.refine(&refined);
-    int inliers = 0;
-    const double score = estimator.score(refined, &inliers);
-    if (score <= st.score) {  // refinement never makes the result worse
-      *best = refined;
-      st.score = score;
-      st.num_inliers = inliers;
     }
   }
   st.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();

@@ -36,13 +36,9 @@ struct FewObjectOptions {
   RefinerOptions refiner;
 };
 
-struct ScoredPose {
-  Pose pose;
-  double cost = 0.0;  ///< the refiner's robust cost at the pose (normalised W2, plus gravity)
-};
-
 /// Poses from two ellipse-ellipsoid correspondences (distinct ellipsoid centres), optionally
-/// constrained by gravity.
+/// constrained by gravity. Each pose's cost is the refiner's robust cost there (normalised W2,
+/// plus gravity).
 std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
                                             const std::optional<GravityPrior>& gravity = std::nullopt,
                                             const FewObjectOptions& options = {});

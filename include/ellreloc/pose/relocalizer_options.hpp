@@ -1,0 +1,172 @@
+#pragma once
+/// \file relocalizer_options.hpp
+/// The ObjectRelocalizer's options, one group per stage of its pipeline (docs/pose.md says what
+/// each default was measured against):
+///   search      which hypotheses are generated from triplets of candidate pairs, and the budgets
+///   scoring     how a pose is scored against the observations (the one cost every stage uses)
+///   few_objects poses from one or two objects for frames with few observations
+///   gravity     how an optional gravity prior gates and joins the refinement
+///   refinement  which hypotheses are refined, and how
+/// validate() names the first field out of range; the relocalizer then answers InvalidInput.
+
+#include <cmath>
+#include <string>
+
+#include "ellreloc/core/ransac.hpp"
+#include "ellreloc/pose/few_object_poses.hpp"
+#include "ellreloc/pose/wasserstein_refiner.hpp"
+
+namespace ellreloc {
+
+enum class HypothesisSampler {
+  Auto,        ///< Exhaustive when there are at most `max_exhaustive_triplets` triplets, else Prosac
+  Exhaustive,  ///< every triplet of candidate pairs (OA-SLAM)
+  Uniform,     ///< random triplets
+  Prosac,      ///< random triplets, best (detection score x object size) first
+};
+
+enum class OverlapMeasure {
+  EllipseIoU,  ///< IoU of the observed ellipse and the projected ellipse
+  BoxIoU,      ///< IoU of the observed box and the projected ellipse's bounding box (OA-SLAM)
+};
+
+/// Hypotheses from triplets of (observation, map object) pairs through P3P.
+struct SearchOptions {
+  HypothesisSampler sampler = HypothesisSampler::Auto;
+  long max_exhaustive_triplets = 1000;  ///< Auto enumerates every triplet up to this many
+  bool correct_centres = true;          ///< re-solve P3P with the projected-centre offset removed
+  /// Drop a pose when one of its own three pairs overlaps less than scoring.min_overlap: a
+  /// wrong triplet rarely fits the three shapes, and this costs three overlaps, not a map.
+  bool check_sample_overlap = true;
+  /// Sample and hypothesis budgets, adaptive stopping and seed. The Exhaustive sampler
+  /// enumerates every triplet: only max_hypotheses and max_time_ms bound it.
+  RansacOptions budget;
+  /// A machine-independent bound on the work: max_hypotheses shrinks to this many overlaps
+  /// over (map objects x usable observations), but never below min_hypotheses. 0: no bound.
+  long max_overlap_evaluations = 40000000;
+  long min_hypotheses = 1000;
+
+  SearchOptions() {
+    budget.min_iterations = 50;
+    budget.max_iterations = 20000;
+    budget.max_hypotheses = 50000;
+    budget.max_time_ms = 0.0;  // a time budget makes results depend on the machine: off by default
+    budget.success_probability = 0.999;
+  }
+};
+
+/// The cost of a pose: observations and projected map objects matched one to one (greedy on
+/// overlap); a match costs 1 - overlap x label weight, an observation left out `unmatched_cost`.
+struct ScoringOptions {
+  OverlapMeasure overlap = OverlapMeasure::EllipseIoU;
+  /// Below this overlap there is no match. Low, because a true match between an inexact map
+  /// and a box-inscribed ellipse often overlaps little.
+  double min_overlap = 0.15;
+  /// At 1 every match is worth more than a miss, so a pose that explains more objects
+  /// moderately beats one that explains fewer very well.
+  double unmatched_cost = 1.0;
+  /// An object is a candidate for an observation of category c when at least this share of its
+  /// mapped detections carried c (MapObject::categoryShare); without a label histogram only
+  /// equal categories match. Above 0.5 only the majority label matches.
+  double min_category_share = 0.05;
+  /// A match through a minority label (share below 0.5) counts as share / 0.5 of a match.
+  bool weigh_minority_labels = true;
+  /// Fewer matched observations: no consistent hypothesis. Two objects constrain a pose (10
+  /// equations, 6 unknowns); a frame with one usable observation needs gravity and one suffices.
+  int min_inliers = 2;
+};
+
+/// Poses from one or two objects (few_object_poses.hpp): frames with few usable observations,
+/// and frames where no triplet explains three.
+struct FewObjectSearchOptions {
+  bool enabled = true;
+  /// With at most this many usable observations, pairs are tried besides triplets.
+  int max_observations = 2;
+  long max_pair_hypotheses = 200;  ///< pairs of candidate pairs given to the two-object solver
+  FewObjectOptions solver;
+};
+
+/// What a gravity prior (relocalize(..., gravity)) does besides giving one-object poses.
+struct GravityOptions {
+  /// Hypotheses tilted more than max(gate_deg, 5 sigma) from the prior are dropped: loose,
+  /// because a P3P pose from three box centres is often 5-10 degrees off before refinement.
+  double gate_deg = 15.0;
+  /// Also use the prior when refining poses that rest on three or more objects (by default
+  /// only poses on fewer objects, whose tilt the objects constrain weakly).
+  bool in_every_refinement = false;
+};
+
+/// The best distinct hypotheses are refined with the Wasserstein refiner on all their matches.
+struct RefinementStageOptions {
+  bool enabled = true;
+  int top_k = 10;            ///< distinct hypotheses kept for refinement (the best raw one often refines worse)
+  double cost_margin = 3.0;  ///< ... of which only those within this cost of the best are refined
+  int rounds = 3;            ///< refine, match again at the refined pose, refine again while observations join
+  RefinerOptions refiner;
+};
+
+struct RelocalizerOptions {
+  SearchOptions search;
+  ScoringOptions scoring;
+  FewObjectSearchOptions few_objects;
+  GravityOptions gravity;
+  RefinementStageOptions refinement;
+
+  /// OA-SLAM's relocalization as a baseline: every detection triplet against every object
+  /// triplet of equal categories, P3P on box centres, box-IoU scoring, no refinement. Give it
+  /// box-inscribed observations (observationFromBox).
+  static RelocalizerOptions oaSlam() {
+    RelocalizerOptions o;
+    o.search.sampler = HypothesisSampler::Exhaustive;
+    o.search.correct_centres = false;
+    o.search.check_sample_overlap = false;
+    o.search.budget.max_hypotheses = 1L << 40;
+    o.search.max_overlap_evaluations = 0;  // the baseline enumerates everything
+    o.scoring.overlap = OverlapMeasure::BoxIoU;
+    o.scoring.min_category_share = 1.0;  // equal (majority) categories only
+    o.scoring.min_inliers = 3;
+    o.scoring.min_overlap = 0.25;
+    o.scoring.unmatched_cost = 1.0 - o.scoring.min_overlap;  // a weak match is worth nothing
+    o.few_objects.enabled = false;
+    o.refinement.enabled = false;
+    o.refinement.top_k = 1;
+    return o;
+  }
+
+  /// Empty when every field is in range, else one line naming the first field that is not.
+  std::string validate() const {
+    const auto finite = [](double x) { return std::isfinite(x); };
+    if (search.max_exhaustive_triplets < 0) return "search.max_exhaustive_triplets is negative";
+    if (search.budget.min_iterations < 0 || search.budget.max_iterations < 0)
+      return "search.budget iteration counts are negative";
+    if (search.budget.max_hypotheses < 0) return "search.budget.max_hypotheses is negative";
+    if (!finite(search.budget.max_time_ms) || search.budget.max_time_ms < 0)
+      return "search.budget.max_time_ms is negative or not finite";
+    if (!(search.budget.success_probability > 0 && search.budget.success_probability < 1))
+      return "search.budget.success_probability is not in (0, 1)";
+    if (search.max_overlap_evaluations < 0 || search.min_hypotheses < 0)
+      return "search.max_overlap_evaluations or search.min_hypotheses is negative";
+    if (!(scoring.min_overlap >= 0 && scoring.min_overlap <= 1)) return "scoring.min_overlap is not in [0, 1]";
+    if (!(finite(scoring.unmatched_cost) && scoring.unmatched_cost >= 0))
+      return "scoring.unmatched_cost is negative or not finite";
+    if (!(scoring.min_category_share >= 0 && scoring.min_category_share <= 1))
+      return "scoring.min_category_share is not in [0, 1]";
+    if (scoring.min_inliers < 1) return "scoring.min_inliers is below 1";
+    if (few_objects.max_observations < 0 || few_objects.max_pair_hypotheses < 0)
+      return "few_objects.max_observations or few_objects.max_pair_hypotheses is negative";
+    if (few_objects.solver.angle_steps < 1 || !(few_objects.solver.axis_step_deg > 0) ||
+        !finite(few_objects.solver.axis_step_deg) || few_objects.solver.max_poses < 0)
+      return "few_objects.solver has a non-positive step or a negative pose count";
+    if (!(finite(gravity.gate_deg) && gravity.gate_deg >= 0)) return "gravity.gate_deg is negative or not finite";
+    if (refinement.top_k < 1 || refinement.rounds < 0) return "refinement.top_k below 1 or refinement.rounds negative";
+    if (!(refinement.cost_margin >= 0)) return "refinement.cost_margin is negative or not a number";
+    const RefinerOptions& r = refinement.refiner;
+    if (!(finite(r.object_loss_scale) && r.object_loss_scale > 0) || !(finite(r.point_sigma_px) && r.point_sigma_px > 0) ||
+        !(finite(r.point_loss_scale) && r.point_loss_scale > 0) || !(finite(r.point_weight) && r.point_weight >= 0))
+      return "refinement.refiner has a non-positive or non-finite scale or weight";
+    if (r.max_iterations < 0 || !(r.function_tolerance >= 0)) return "refinement.refiner has a negative tolerance or count";
+    return "";
+  }
+};
+
+}  // namespace ellreloc

@@ -1,0 +1,34 @@
+#pragma once
+// Which map objects each observation may be: the first step of the relocalization pipeline.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ellreloc/core/object_map.hpp"
+#include "ellreloc/core/observation.hpp"
+#include "ellreloc/pose/relocalizer_options.hpp"
+
+namespace ellreloc::pipeline {
+
+/// An observation and a map object it may be, before any pose.
+struct CandidatePair {
+  int observation;
+  int object;
+  double quality;  // label share x detection score x apparent object size: PROSAC order
+};
+
+/// Usable observations and their candidate objects (same category, or a share of the object's
+/// label histogram).
+struct Candidates {
+  std::vector<char> usable;                      // per observation
+  std::vector<std::vector<int>> of_observation;  // candidate objects of each observation
+  std::vector<CandidatePair> pairs;              // best (PROSAC) first
+  int num_usable = 0;
+};
+
+/// Observations that are invalid or have no candidate object go to `skipped` with the reason.
+Candidates collectCandidates(const std::vector<Observation>& observations, const ObjectMap& map,
+                             const ScoringOptions& options, std::vector<std::pair<int, std::string>>* skipped);
+
+}  // namespace ellreloc::pipeline

@@ -1,0 +1,119 @@
+#include "hypothesis_estimator.hpp"
+
+#include <array>
+#include <cmath>
+
+#include "ellreloc/core/p3p.hpp"
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/pose/few_object_poses.hpp"
+
+namespace ellreloc::pipeline {
+
+namespace {
+
+EllipseMatch ellipseMatchOf(const CandidatePair& pair, const std::vector<Observation>& observations,
+                            const ObjectMap& map) {
+  return {observations[static_cast<size_t>(pair.observation)].ellipse,
+          map.objects[static_cast<size_t>(pair.object)].ellipsoid};
+}
+
+}  // namespace
+
+bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int count, KnownProjections* own) const {
+  if (!gate_.admits(pose)) return false;
+  own->count = 0;
+  for (int k = 0; k < count; ++k) {
+    const CandidatePair& c = pairs_[static_cast<size_t>(pair_indices[k])];
+    const Projection p = project(map_.objects[static_cast<size_t>(c.object)].ellipsoid, K_, pose);
+    if (!p.ok()) return false;
+    own->objects[k] = c.object;
+    own->ellipses[k] = p.ellipse;
+    own->count = k + 1;
+  }
+  return true;
+}
+
+int HypothesisEstimator::generate(const int* s, Model* models) const {
+  const CandidatePair &a = pairs_[s[0]], &b = pairs_[s[1]], &c = pairs_[s[2]];
+  if (a.observation == b.observation || a.observation == c.observation || b.observation == c.observation ||
+      a.object == b.object || a.object == c.object || b.object == c.object)
+    return 0;
+  std::array<Eigen::Vector3d, 3> bearings, centres;
+  for (int k = 0; k < 3; ++k) {
+    const CandidatePair& pair = pairs_[s[k]];
+    bearings[k] = K_.bearing(observations_[pair.observation].ellipse.center());
+    centres[k] = map_.objects[pair.object].ellipsoid.center();
+  }
+  std::array<Pose, 4> poses;
+  const int n = p3p(bearings, centres, &poses);
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    Model m{poses[i], {}};
+    if (options_.search.correct_centres && !correctCentres(s, &m.pose)) continue;
+    if (!accept(m.pose, s, 3, &m.own)) continue;
+    bool overlapping = true;
+    for (int k = 0; k < 3 && overlapping && options_.search.check_sample_overlap; ++k)
+      overlapping = scorer_.overlap(observations_[pairs_[s[k]].observation], m.own.ellipses[k], kRankingIoUVertices) >=
+                    options_.scoring.min_overlap;
+    if (overlapping) models[count++] = m;
+  }
+  return count;
+}
+
+/// The centre of a projected ellipsoid's image is not the image of its centre: remove that
+/// offset (measured at the current pose) from the observed centres and solve P3P again.
+bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
+  std::array<Eigen::Vector3d, 3> bearings, centres;
+  for (int k = 0; k < 3; ++k) {
+    const Ellipsoid& e = map_.objects[pairs_[s[k]].object].ellipsoid;
+    const Projection p = project(e, K_, *pose);
+    if (!p) return false;
+    const Eigen::Vector2d offset = p.ellipse.center() - K_.project(pose->transform(e.center()));
+    bearings[k] = K_.bearing(observations_[pairs_[s[k]].observation].ellipse.center() - offset);
+    centres[k] = e.center();
+  }
+  std::array<Pose, 4> poses;
+  const int n = p3p(bearings, centres, &poses);
+  double best = 1e9;
+  for (int i = 0; i < n; ++i) {
+    const double d = rotationErrorDeg(poses[i].rotation(), pose->rotation()) * M_PI / 180.0 +
+                     (poses[i].center() - pose->center()).norm();
+    if (d < best) best = d, *pose = poses[i];
+  }
+  return n > 0;
+}
+
+double HypothesisEstimator::score(const Model& model, int* num_inliers) const {
+  thread_local std::vector<ObjectCorrespondence> matches;
+  const double cost = scorer_.cost(model.pose, kRankingIoUVertices, &matches, &model.own);
+  *num_inliers = static_cast<int>(matches.size());
+  return cost;
+}
+
+void HypothesisEstimator::fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,
+                                     std::vector<Model>* out) const {
+  for (const ScoredPose& p : poses) {
+    Model m{p.pose, {}};
+    if (!accept(m.pose, pair_indices, count, &m.own)) continue;
+    bool overlapping = true;  // the pairs the pose came from must match at it
+    for (int k = 0; k < count && overlapping; ++k)
+      overlapping = scorer_.overlap(observations_[pairs_[pair_indices[k]].observation], m.own.ellipses[k],
+                                    kRankingIoUVertices) >= options_.scoring.min_overlap;
+    if (overlapping) out->push_back(m);
+  }
+}
+
+void HypothesisEstimator::fromTwoPairs(int a, int b, const std::optional<GravityPrior>& gravity,
+                                       std::vector<Model>* out) const {
+  const int own[2] = {a, b};
+  fromSolver(posesFromTwoObjects(K_, ellipseMatchOf(pairs_[a], observations_, map_),
+                                 ellipseMatchOf(pairs_[b], observations_, map_), gravity, options_.few_objects.solver),
+             own, 2, out);
+}
+
+void HypothesisEstimator::fromOnePair(int a, const GravityPrior& gravity, std::vector<Model>* out) const {
+  fromSolver(posesFromOneObject(K_, ellipseMatchOf(pairs_[a], observations_, map_), gravity, options_.few_objects.solver),
+             &a, 1, out);
+}
+
+}  // namespace ellreloc::pipeline

@@ -1,0 +1,73 @@
+#pragma once
+// Pose hypotheses from minimal samples of candidate pairs: P3P on three (the RANSAC estimator),
+// the two-object solver on two, one object and gravity on one. Every pose is checked the same
+// way (gravity gate, its own objects in view and overlapping their observations) and carries
+// the projections of its own objects, so scoring does not project them again.
+
+#include <optional>
+#include <vector>
+
+#include "candidates.hpp"
+#include "ellreloc/core/camera.hpp"
+#include "ellreloc/pose/gravity_prior.hpp"
+#include "ellreloc/pose/relocalizer_options.hpp"
+#include "pose_scorer.hpp"
+
+namespace ellreloc::pipeline {
+
+/// Drops poses that tilt the camera more than max(gate_deg, 5 sigma) away from a gravity prior.
+struct GravityGate {
+  const GravityPrior* prior = nullptr;  // none: every pose passes
+  double gate_deg = 15.0;
+  bool admits(const Pose& pose) const {
+    return !prior || prior->errorDeg(pose) <= std::max(gate_deg, 5.0 * prior->sigma_deg);
+  }
+};
+
+/// A hypothesis: a pose and its own objects' projections at it.
+struct PoseHypothesis {
+  Pose pose;
+  KnownProjections own;
+};
+
+class HypothesisEstimator {
+ public:
+  using Model = PoseHypothesis;
+  static constexpr int kSampleSize = 3;
+  static constexpr int kMaxModels = 4;
+
+  HypothesisEstimator(const std::vector<Observation>& observations, const Candidates& candidates,
+                      const ObjectMap& map, const Intrinsics& K, const RelocalizerOptions& options,
+                      const GravityGate& gate, PoseScorer& scorer)
+      : observations_(observations), pairs_(candidates.pairs), map_(map), K_(K), options_(options), gate_(gate),
+        scorer_(scorer) {}
+
+  // The RANSAC estimator concept (core/ransac.hpp) over candidate pairs.
+  size_t numData() const { return pairs_.size(); }
+  /// P3P on the observed centres of three pairs, with the projected-centre correction.
+  int generate(const int* sample, Model* models) const;
+  /// The ranking cost (PoseScorer::cost at kRankingIoUVertices).
+  double score(const Model& model, int* num_inliers) const;
+
+  /// Poses from two candidate pairs (two-object solver), checked like P3P's; appended to `out`.
+  void fromTwoPairs(int a, int b, const std::optional<GravityPrior>& gravity, std::vector<Model>* out) const;
+  /// Poses from one candidate pair and gravity; appended to `out`.
+  void fromOnePair(int a, const GravityPrior& gravity, std::vector<Model>* out) const;
+
+ private:
+  /// The gate, then every own pair in view and overlapping its observation; fills `own`.
+  bool accept(const Pose& pose, const int* pair_indices, int count, KnownProjections* own) const;
+  bool correctCentres(const int* pair_indices, Pose* pose) const;
+  void fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,
+                  std::vector<Model>* out) const;
+
+  const std::vector<Observation>& observations_;
+  const std::vector<CandidatePair>& pairs_;
+  const ObjectMap& map_;
+  const Intrinsics& K_;
+  const RelocalizerOptions& options_;
+  GravityGate gate_;
+  PoseScorer& scorer_;
+};
+
+}  // namespace ellreloc::pipeline

@@ -1,0 +1,87 @@
+#include "pose_scorer.hpp"
+
+#include <algorithm>
+
+#include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/projection.hpp"
+
+namespace ellreloc::pipeline {
+
+PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candidates& candidates,
+                       const ObjectMap& map, const Intrinsics& K, const ScoringOptions& options)
+    : observations_(observations), candidates_(candidates), map_(map), K_(K), options_(options) {
+  const auto& cands = candidates.of_observation;
+  std::vector<char> relevant(map.objects.size(), 0);
+  for (const auto& c : cands)
+    for (int j : c) relevant[static_cast<size_t>(j)] = 1;
+  for (size_t j = 0; j < relevant.size(); ++j)
+    if (relevant[j]) relevant_.push_back(static_cast<int>(j));
+  // A match to an object that carried the observed label in only a minority of its detections
+  // is worth that share of a match (full at a majority, share >= 0.5).
+  label_weight_.resize(cands.size());
+  for (size_t i = 0; i < cands.size(); ++i)
+    for (int j : cands[i]) {
+      const MapObject& m = map.objects[static_cast<size_t>(j)];
+      const bool weigh = options.weigh_minority_labels && m.category != observations[i].category;
+      label_weight_[i].push_back(weigh ? std::min(1.0, m.categoryShare(observations[i].category) / 0.5) : 1.0);
+    }
+  projected_.resize(map.objects.size());
+  projects_.resize(map.objects.size(), 0);
+  observation_taken_.resize(observations.size());
+  object_taken_.resize(map.objects.size());
+  all_matches_.reserve(64);
+}
+
+double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int vertices) const {
+  return options_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, projected.boundingBox())
+                                                    : ellipseIoU(o.ellipse, projected, vertices);
+}
+
+double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches,
+                        const KnownProjections* known) {
+  for (int j : relevant_) {
+    const int* k = known ? std::find(known->objects, known->objects + known->count, j) : nullptr;
+    if (known && k != known->objects + known->count) {
+      projects_[j] = 1;
+      projected_[j] = known->ellipses[k - known->objects];
+      continue;
+    }
+    const Projection p = project(map_.objects[static_cast<size_t>(j)].ellipsoid, K_, pose);
+    projects_[j] = p.ok();
+    if (p.ok()) projected_[j] = p.ellipse;
+  }
+  all_matches_.clear();
+  for (size_t i = 0; i < observations_.size(); ++i) {
+    if (!candidates_.usable[i]) continue;
+    const Observation& o = observations_[i];
+    const std::vector<int>& cands = candidates_.of_observation[i];
+    for (size_t c = 0; c < cands.size(); ++c) {
+      const int j = cands[c];
+      if (!projects_[j]) continue;
+      const Box pb = projected_[j].boundingBox();
+      if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
+      const double ov = options_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, pb)
+                                                                    : ellipseIoU(o.ellipse, projected_[j], vertices);
+      if (ov >= options_.min_overlap)
+        all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
+    }
+  }
+  std::sort(all_matches_.begin(), all_matches_.end(), [](const ObjectCorrespondence& a, const ObjectCorrespondence& b) {
+    return a.credit != b.credit ? a.credit > b.credit
+                                : (a.observation != b.observation ? a.observation < b.observation : a.object < b.object);
+  });
+  std::fill(observation_taken_.begin(), observation_taken_.end(), 0);
+  std::fill(object_taken_.begin(), object_taken_.end(), 0);
+  const double miss = options_.unmatched_cost;
+  double total = miss * candidates_.num_usable;
+  if (matches) matches->clear();
+  for (const ObjectCorrespondence& m : all_matches_) {
+    if (observation_taken_[m.observation] || object_taken_[m.object]) continue;
+    observation_taken_[m.observation] = object_taken_[m.object] = 1;
+    total += (1.0 - m.credit) - miss;
+    if (matches) matches->push_back(m);
+  }
+  return total;
+}
+
+}  // namespace ellreloc::pipeline

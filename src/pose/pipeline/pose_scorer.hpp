@@ -1,0 +1,57 @@
+#pragma once
+// The one cost of the relocalization pipeline: every stage (sample checks, RANSAC, the few-object
+// poses, refinement, scorePose) ranks poses with it.
+
+#include <vector>
+
+#include "candidates.hpp"
+#include "ellreloc/core/camera.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+
+namespace ellreloc::pipeline {
+
+/// Vertices of the polygon ellipseIoU uses while ranking hypotheses (IoU error ~1e-2, ample to
+/// rank poses and 3x faster than 128); the refinement and the result use kReportIoUVertices.
+constexpr int kRankingIoUVertices = 32;
+constexpr int kReportIoUVertices = 128;
+
+/// Projections already computed at the pose being scored (a hypothesis's own objects).
+struct KnownProjections {
+  int count = 0;
+  int objects[3] = {0, 0, 0};
+  Ellipse ellipses[3];
+};
+
+/// Scores poses: projects the candidate objects and matches them one to one to the
+/// observations. Holds scratch buffers: one scorer per call, never shared between threads.
+class PoseScorer {
+ public:
+  PoseScorer(const std::vector<Observation>& observations, const Candidates& candidates, const ObjectMap& map,
+             const Intrinsics& K, const ScoringOptions& options);
+
+  /// The overlap of an observation and a projected ellipse under the options' measure.
+  double overlap(const Observation& o, const Ellipse& projected, int vertices) const;
+
+  /// The cost of a pose: unmatched_cost per usable observation, less (unmatched_cost - (1 -
+  /// credit)) per one-to-one match, greedy on credit. Fills the matches when asked.
+  double cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches = nullptr,
+              const KnownProjections* known = nullptr);
+
+  const ScoringOptions& options() const { return options_; }
+
+ private:
+  const std::vector<Observation>& observations_;
+  const Candidates& candidates_;
+  const ObjectMap& map_;
+  const Intrinsics& K_;
+  const ScoringOptions& options_;
+  std::vector<int> relevant_;                      // objects that are some observation's candidate
+  std::vector<std::vector<double>> label_weight_;  // per observation, per candidate
+  // Scratch, reused across calls.
+  std::vector<Ellipse> projected_;
+  std::vector<char> projects_;
+  std::vector<ObjectCorrespondence> all_matches_;
+  std::vector<char> observation_taken_, object_taken_;
+};
+
+}  // namespace ellreloc::pipeline

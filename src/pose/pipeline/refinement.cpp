@@ -1,0 +1,84 @@
+#include "refinement.hpp"
+
+namespace ellreloc::pipeline {
+
+namespace {
+
+/// The prior joins a refinement where the objects leave the tilt weakly constrained.
+std::optional<GravityPrior> refinementGravity(const RefinementContext& c, size_t matched) {
+  return matched < 3 || c.options.gravity.in_every_refinement ? c.gravity : std::nullopt;
+}
+
+/// Refine on the matches, match again at the refined pose, and repeat while that explains the
+/// observations better: a refined pose often brings more objects into overlap.
+ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementContext& c) {
+  ChosenPose h;
+  h.pose = start;
+  h.cost = scorer.cost(start, kReportIoUVertices, &h.matches);
+  const RefinementStageOptions& opt = c.options.refinement;
+  for (int round = 0; round < opt.rounds && opt.enabled; ++round) {
+    if (static_cast<int>(h.matches.size()) < (c.gravity ? 1 : 2)) break;
+    const RefinementResult r = refinePose(c.K, h.pose, ellipseMatches(h.matches, c.observations, c.map), {},
+                                          opt.refiner, refinementGravity(c, h.matches.size()));
+    if (r.fell_back || !c.gate.admits(r.pose)) break;
+    std::vector<ObjectCorrespondence> rematched;
+    const double refined_cost = scorer.cost(r.pose, kReportIoUVertices, &rematched);
+    if (refined_cost > h.cost) break;
+    const bool more = rematched.size() > h.matches.size();
+    h.pose = r.pose;
+    h.cost = refined_cost;
+    h.refined = true;
+    h.matches = std::move(rematched);
+    if (!more) break;
+  }
+  return h;
+}
+
+}  // namespace
+
+std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>& matches,
+                                         const std::vector<Observation>& observations, const ObjectMap& map) {
+  std::vector<EllipseMatch> out;
+  out.reserve(matches.size());
+  for (const ObjectCorrespondence& m : matches)
+    out.push_back({observations[static_cast<size_t>(m.observation)].ellipse,
+                   map.objects[static_cast<size_t>(m.object)].ellipsoid});
+  return out;
+}
+
+ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best, PoseScorer& scorer,
+                            const RefinementContext& context) {
+  ChosenPose best;
+  best.pose = search_best;
+  best.cost = scorer.cost(search_best, kReportIoUVertices);
+  for (const ScoredPose& h : pool.entries()) {
+    if (h.cost > pool.best().cost + context.options.refinement.cost_margin) break;  // ascending costs
+    ChosenPose candidate = refineRounds(h.pose, scorer, context);
+    if (candidate.cost < best.cost || (candidate.refined && candidate.cost <= best.cost)) {
+      best.pose = candidate.pose;
+      best.cost = candidate.cost;
+      best.refined = candidate.refined;
+    }
+  }
+  best.cost = scorer.cost(best.pose, kReportIoUVertices, &best.matches);
+  return best;
+}
+
+ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& points, PoseScorer& scorer,
+                            const RefinementContext& c) {
+  if (points.empty() || !c.options.refinement.enabled || chosen.matches.empty()) return chosen;
+  const RefinementResult r = refinePose(c.K, chosen.pose, ellipseMatches(chosen.matches, c.observations, c.map), points,
+                                        c.options.refinement.refiner, refinementGravity(c, chosen.matches.size()));
+  if (r.fell_back) return chosen;
+  std::vector<ObjectCorrespondence> with_points;
+  const double cost = scorer.cost(r.pose, kReportIoUVertices, &with_points);
+  if (with_points.size() >= chosen.matches.size() && c.gate.admits(r.pose)) {
+    chosen.pose = r.pose;
+    chosen.cost = cost;
+    chosen.matches = std::move(with_points);
+    chosen.refined = true;
+  }
+  return chosen;
+}
+
+}  // namespace ellreloc::pipeline

@@ -1,0 +1,46 @@
+#pragma once
+// The refinement stage: the best distinct hypotheses refined with the Wasserstein refiner on
+// all their matches, and optionally with the frame's keypoints.
+
+#include <optional>
+#include <vector>
+
+#include "hypothesis_estimator.hpp"
+#include "hypothesis_pool.hpp"
+#include "pose_scorer.hpp"
+
+namespace ellreloc::pipeline {
+
+/// A pose with its cost and matches under the scorer (at kReportIoUVertices).
+struct ChosenPose {
+  Pose pose;
+  double cost = 0.0;
+  std::vector<ObjectCorrespondence> matches;
+  bool refined = false;
+};
+
+/// What refinement needs besides the pool and the scorer.
+struct RefinementContext {
+  const std::vector<Observation>& observations;
+  const ObjectMap& map;
+  const Intrinsics& K;
+  const RelocalizerOptions& options;
+  const std::optional<GravityPrior>& gravity;
+  GravityGate gate;
+};
+
+/// Starts from `search_best` (the search's best pose) and refines every pooled hypothesis
+/// within refinement.cost_margin of the pool's best; returns the lowest-cost result.
+ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best, PoseScorer& scorer,
+                            const RefinementContext& context);
+
+/// Refines the chosen pose again with keypoints matched to map points; keeps the result when it
+/// still explains as many observations.
+ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& points, PoseScorer& scorer,
+                            const RefinementContext& context);
+
+/// The ellipse-ellipsoid pairs of a list of matches, for the refiner.
+std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>& matches,
+                                         const std::vector<Observation>& observations, const ObjectMap& map);
+
+}  // namespace ellreloc::pipeline
