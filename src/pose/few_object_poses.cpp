@@ -45,8 +45,8 @@ std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Mat
 
 namespace {
 
-/// The refiner's object cost (its Cauchy loss, else the plain normalised W2^2) plus the gravity
-/// term: the sweep ranks angles by what the refinement will minimise.
+/// The refiner's object cost (its robust loss of the normalised W2^2) plus the gravity term: the
+/// sweep ranks angles by what the refinement will minimise.
 double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<EllipseMatch>& matches,
                  const std::optional<GravityPrior>& gravity, const RefinerOptions& opt) {
   double total = 0.0;
@@ -54,8 +54,7 @@ double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<Ellips
     const Projection p = project(m.ellipsoid, K, pose);
     if (!p) return std::numeric_limits<double>::infinity();
     const double s = wasserstein2Squared(m.observed, p.ellipse) / m.observed.axes().prod();
-    const double c2 = opt.object_loss_scale * opt.object_loss_scale;
-    total += opt.object_loss == RobustLoss::Cauchy ? c2 * std::log1p(s / c2) : s;
+    total += robustLoss(opt.object_loss, opt.object_loss_scale, s);
   }
   if (gravity) {
     const double angle = gravity->errorDeg(pose) / gravity->sigma_deg;

@@ -19,27 +19,6 @@ using Jet = ceres::Jet<double, 6>;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
-/// rho(s) and rho'(s) of a loss on the squared residual s, with scale c (Ceres' convention:
-/// Huber rho = s for s <= c^2, 2 c sqrt(s) - c^2 beyond; Cauchy rho = c^2 log(1 + s / c^2)).
-void loss(RobustLoss type, double c, double s, double* rho, double* drho) {
-  switch (type) {
-    case RobustLoss::None:
-      *rho = s, *drho = 1.0;
-      return;
-    case RobustLoss::Huber:
-      if (s <= c * c) {
-        *rho = s, *drho = 1.0;
-      } else {
-        const double r = std::sqrt(s);
-        *rho = 2.0 * c * r - c * c, *drho = c / r;
-      }
-      return;
-    case RobustLoss::Cauchy:
-      *rho = c * c * std::log1p(s / (c * c)), *drho = 1.0 / (1.0 + s / (c * c));
-      return;
-  }
-}
-
 /// A gravity prior with unit directions and sigma in radians: the chord |R up_map - up_camera|
 /// is the tilt error in radians while it is small.
 struct UnitGravity {
@@ -77,16 +56,16 @@ struct Problem {
       const Projection p = project(objects[i]->ellipsoid, K, pose);
       if (!p) return false;
       const double s = wasserstein2Squared(objects[i]->observed, p.ellipse) / (object_scale[i] * object_scale[i]);
-      double rho = 0.0, drho = 0.0;
-      loss(opt.object_loss, opt.object_loss_scale, s, &rho, &drho);
+      double drho = 0.0;
+      const double rho = robustLoss(opt.object_loss, opt.object_loss_scale, s, &drho);
       sum += rho;
     }
     for (const PointMatch& m : points) {
       const Eigen::Vector3d x = pose.transform(m.point);
       if (!(x(2) > 0.0)) return false;
       const double s = (K.project(x) - m.observed).squaredNorm() / (opt.point_sigma_px * opt.point_sigma_px);
-      double rho = 0.0, drho = 0.0;
-      loss(opt.point_loss, opt.point_loss_scale, s, &rho, &drho);
+      double drho = 0.0;
+      const double rho = robustLoss(opt.point_loss, opt.point_loss_scale, s, &drho);
       sum += opt.point_weight * rho;
     }
     if (gravity) sum += gravityResidual(pose).squaredNorm();
@@ -147,8 +126,8 @@ struct Problem {
         J.row(k) = r[k].v.transpose() / object_scale[i];
       }
       if (!J.allFinite() || !res.allFinite()) return false;
-      double rho = 0.0, drho = 0.0;
-      loss(opt.object_loss, opt.object_loss_scale, res.squaredNorm(), &rho, &drho);
+      double drho = 0.0;
+      robustLoss(opt.object_loss, opt.object_loss_scale, res.squaredNorm(), &drho);
       *H += drho * J.transpose() * J;
       *g += drho * J.transpose() * res;
     }
@@ -160,8 +139,8 @@ struct Problem {
       Eigen::Vector2d res((u.a - m.observed(0)) / opt.point_sigma_px, (v.a - m.observed(1)) / opt.point_sigma_px);
       J.row(0) = u.v.transpose() / opt.point_sigma_px;
       J.row(1) = v.v.transpose() / opt.point_sigma_px;
-      double rho = 0.0, drho = 0.0;
-      loss(opt.point_loss, opt.point_loss_scale, res.squaredNorm(), &rho, &drho);
+      double drho = 0.0;
+      robustLoss(opt.point_loss, opt.point_loss_scale, res.squaredNorm(), &drho);
       *H += opt.point_weight * drho * J.transpose() * J;
       *g += opt.point_weight * drho * J.transpose() * res;
     }
@@ -299,6 +278,44 @@ Pose solveWithCeres(const Problem& problem, const Pose& initial, const RefinerOp
   return Pose(nearestRotation(q.normalized().toRotationMatrix()), t);
 }
 
+/// Levenberg-Marquardt on a left perturbation of the pose: a step is accepted only when the
+/// robust cost decreases. `cost_io` holds the cost at `initial` and receives the final one.
+Pose solveWithLevenbergMarquardt(const Problem& problem, const Pose& initial, const RefinerOptions& options,
+                                 double* cost_io, int* iterations, bool* converged) {
+  Pose pose = initial;
+  double& cost = *cost_io;
+  double lambda = 1e-4;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    *iterations = it + 1;
+    Mat6 H;
+    Vec6 g;
+    if (!problem.normalEquations(pose, &H, &g)) break;
+    bool accepted = false;
+    while (lambda < 1e10) {
+      Mat6 A = H;
+      A.diagonal() += lambda * (H.diagonal().cwiseMax(1e-9));
+      const Vec6 step = -A.ldlt().solve(g);
+      double trial_cost;
+      if (step.allFinite() && problem.cost(applyDelta(pose, step), &trial_cost) && trial_cost < cost) {
+        const double decrease = cost - trial_cost;
+        pose = applyDelta(pose, step);
+        cost = trial_cost;
+        lambda = std::max(lambda / 10.0, 1e-12);
+        accepted = true;
+        if (decrease <= options.function_tolerance * (cost + 1e-12)) *converged = true;
+        break;
+      }
+      lambda *= 10.0;
+    }
+    if (!accepted) {
+      *converged = true;  // no step decreases the cost: a (local) minimum
+      break;
+    }
+    if (*converged) break;
+  }
+  return pose;
+}
+
 }  // namespace
 
 RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std::vector<EllipseMatch>& objects,
@@ -369,37 +386,7 @@ RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std:
     fillResiduals(result);
     return result;
   }
-  Pose pose = initial;
-  double lambda = 1e-4;
-  for (int it = 0; it < options.max_iterations; ++it) {
-    result.iterations = it + 1;
-    Mat6 H;
-    Vec6 g;
-    if (!problem.normalEquations(pose, &H, &g)) break;
-    bool accepted = false;
-    while (lambda < 1e10) {
-      Mat6 A = H;
-      A.diagonal() += lambda * (H.diagonal().cwiseMax(1e-9));
-      const Vec6 step = -A.ldlt().solve(g);
-      double trial_cost;
-      if (step.allFinite() && problem.cost(applyDelta(pose, step), &trial_cost) && trial_cost < cost) {
-        const double decrease = cost - trial_cost;
-        pose = applyDelta(pose, step);
-        cost = trial_cost;
-        lambda = std::max(lambda / 10.0, 1e-12);
-        accepted = true;
-        if (decrease <= options.function_tolerance * (cost + 1e-12)) result.converged = true;
-        break;
-      }
-      lambda *= 10.0;
-    }
-    if (!accepted) {
-      result.converged = true;  // no step decreases the cost: a (local) minimum
-      break;
-    }
-    if (result.converged) break;
-  }
-  result.pose = pose;
+  result.pose = solveWithLevenbergMarquardt(problem, initial, options, &cost, &result.iterations, &result.converged);
   result.final_cost = cost;
   result.fell_back = false;
   fillResiduals(result);

@@ -1,4 +1,5 @@
 #include <ceres/jet.h>
+#include <ceres/loss_function.h>
 #include <gtest/gtest.h>
 
 #include "../random_geometry.hpp"
@@ -211,4 +212,21 @@ TEST(WassersteinRefiner, ResidualDerivativesAreFiniteAtZeroDistance) {
   EXPECT_FALSE(r0.fell_back);
   EXPECT_LT(positionError(r0.pose, s.truth), 1e-6);
   EXPECT_LT(r0.final_cost, 1e-12);
+}
+
+// One robust loss for the refiner and the two-object sweep, in Ceres' convention: checked
+// against Ceres' own loss functions.
+TEST(RobustLoss, MatchesCeresLossFunctions) {
+  for (const double c : {0.3, 1.0, 2.5})
+    for (const double s : {0.0, 0.01, 0.5, 1.0, 4.0, 50.0}) {
+      double ceres_rho[3];
+      ceres::HuberLoss(c).Evaluate(s, ceres_rho);
+      double drho = 0.0;
+      EXPECT_NEAR(robustLoss(RobustLoss::Huber, c, s, &drho), ceres_rho[0], 1e-12);
+      EXPECT_NEAR(drho, ceres_rho[1], 1e-12);
+      ceres::CauchyLoss(c).Evaluate(s, ceres_rho);
+      EXPECT_NEAR(robustLoss(RobustLoss::Cauchy, c, s, &drho), ceres_rho[0], 1e-12);
+      EXPECT_NEAR(drho, ceres_rho[1], 1e-12);
+      EXPECT_EQ(robustLoss(RobustLoss::None, c, s), s);
+    }
 }

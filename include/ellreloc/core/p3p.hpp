@@ -92,6 +92,29 @@ inline bool splitPlanePair(const Eigen::Matrix3d& D, Eigen::Vector3d* l, Eigen::
 
 }  // namespace detail
 
+namespace detail {
+
+/// Gauss-Newton on the three original equations |lambda_i y_i - lambda_j y_j|^2 = a_ij
+/// (b_ij = -2 y_i . y_j), from the depths the elimination gave.
+inline void polishDepths(double a12, double a13, double a23, double b12, double b13, double b23,
+                         Eigen::Vector3d* depths) {
+  Eigen::Vector3d& lam = *depths;
+  for (int it = 0; it < 5; ++it) {
+    const Eigen::Vector3d res(lam(0) * lam(0) + lam(1) * lam(1) + b12 * lam(0) * lam(1) - a12,
+                              lam(0) * lam(0) + lam(2) * lam(2) + b13 * lam(0) * lam(2) - a13,
+                              lam(1) * lam(1) + lam(2) * lam(2) + b23 * lam(1) * lam(2) - a23);
+    if (res.cwiseAbs().maxCoeff() < 1e-15 * (a12 + a13 + a23)) break;
+    Eigen::Matrix3d J;
+    J << 2 * lam(0) + b12 * lam(1), 2 * lam(1) + b12 * lam(0), 0.0, 2 * lam(0) + b13 * lam(2), 0.0,
+        2 * lam(2) + b13 * lam(0), 0.0, 2 * lam(1) + b23 * lam(2), 2 * lam(2) + b23 * lam(1);
+    const double detJ = J.determinant();
+    if (!(std::abs(detJ) > 1e-300)) break;
+    lam -= J.inverse() * res;
+  }
+}
+
+}  // namespace detail
+
 /// Solves P3P for unit bearing vectors (camera frame) and world points. Writes up to four
 /// world->camera poses with all three depths positive into `poses` and returns their count.
 /// Never produces NaN: degenerate input (coincident or collinear points, parallel bearings)
@@ -181,19 +204,7 @@ inline int p3p(const std::array<Eigen::Vector3d, 3>& bearings, const std::array<
           lam(1) = tau * lam(2);
           lam(0) = (w0 * tau + w1) * lam(2);
           if (!(lam(0) > 0.0)) continue;
-          // Gauss-Newton on the three original equations.
-          for (int it = 0; it < 5; ++it) {
-            const Eigen::Vector3d res(lam(0) * lam(0) + lam(1) * lam(1) + b12 * lam(0) * lam(1) - a12,
-                                      lam(0) * lam(0) + lam(2) * lam(2) + b13 * lam(0) * lam(2) - a13,
-                                      lam(1) * lam(1) + lam(2) * lam(2) + b23 * lam(1) * lam(2) - a23);
-            if (res.cwiseAbs().maxCoeff() < 1e-15 * (a12 + a13 + a23)) break;
-            Eigen::Matrix3d J;
-            J << 2 * lam(0) + b12 * lam(1), 2 * lam(1) + b12 * lam(0), 0.0, 2 * lam(0) + b13 * lam(2), 0.0,
-                2 * lam(2) + b13 * lam(0), 0.0, 2 * lam(1) + b23 * lam(2), 2 * lam(2) + b23 * lam(1);
-            const double detJ = J.determinant();
-            if (!(std::abs(detJ) > 1e-300)) break;
-            lam -= J.inverse() * res;
-          }
+          detail::polishDepths(a12, a13, a23, b12, b13, b23, &lam);
           if (!(lam.minCoeff() > 0.0) || !lam.allFinite()) continue;
           const Eigen::Vector3d c12 = lam(0) * y1 - lam(1) * y2, c13 = lam(0) * y1 - lam(2) * y3;
           Eigen::Matrix3d Yc;

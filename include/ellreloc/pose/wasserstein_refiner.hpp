@@ -17,6 +17,7 @@
 /// returned pose never has a higher cost than the one given: if it would, the given pose is
 /// returned and `fell_back` says so.
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,21 @@
 namespace ellreloc {
 
 enum class RobustLoss { None, Huber, Cauchy };
+
+/// rho(s) of a robust loss on a squared residual s with scale c, in Ceres' convention: Huber
+/// rho = s for s <= c^2, 2 c sqrt(s) - c^2 beyond; Cauchy rho = c^2 log(1 + s / c^2). Writes
+/// rho'(s) to `drho` when given.
+inline double robustLoss(RobustLoss type, double c, double s, double* drho = nullptr) {
+  double rho = s, d = 1.0;
+  if (type == RobustLoss::Huber && s > c * c) {
+    const double r = std::sqrt(s);
+    rho = 2.0 * c * r - c * c, d = c / r;
+  } else if (type == RobustLoss::Cauchy) {
+    rho = c * c * std::log1p(s / (c * c)), d = 1.0 / (1.0 + s / (c * c));
+  }
+  if (drho) *drho = d;
+  return rho;
+}
 
 /// Which solver minimises the cost; both use the same residuals and losses.
 enum class RefinerBackend {
