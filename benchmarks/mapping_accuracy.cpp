@@ -11,6 +11,7 @@
 #include <map>
 #include <string>
 
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/rgbd.hpp"
@@ -23,11 +24,7 @@ using namespace ellreloc;
 
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+double medianOrNan(std::vector<double> v) { return ellreloc::median(std::move(v), std::nan("")); }
 
 /// Direction (radians, mod pi) of the longest horizontal extent of an ellipsoid (z up).
 double horizontalYaw(const Ellipsoid& e) {
@@ -90,7 +87,7 @@ void score(const std::vector<Ellipsoid>& est, const std::vector<int>& est_catego
 void printRow(const char* name, const Errors& e) {
   const std::string rate = e.keyframes > 0 ? std::to_string(static_cast<int>(e.keyframes / e.seconds)) : "-";
   std::printf("| %s | %d / %d | %d | %.1f | %.1f | %.1f | %.1f | %s |\n", name, e.found, e.expected, e.spurious,
-              100.0 * median(e.centre), median(e.yaw), 100.0 * median(e.axis), 100.0 * median(e.axis_large),
+              100.0 * medianOrNan(e.centre), medianOrNan(e.yaw), 100.0 * medianOrNan(e.axis), 100.0 * medianOrNan(e.axis_large),
               rate.c_str());
 }
 

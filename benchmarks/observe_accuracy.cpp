@@ -10,6 +10,7 @@
 #include <random>
 
 #include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
 #include "ellreloc/observe/observe.hpp"
@@ -74,11 +75,7 @@ bool render(const std::vector<Part>& parts, const Pose& pose, BinaryMask* mask) 
   return true;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+double medianOrNan(std::vector<double> v) { return ellreloc::median(std::move(v), NAN); }
 
 }  // namespace
 
@@ -162,7 +159,7 @@ int main() {
       if (it == methods.end())
         std::printf(" - |");
       else
-        std::printf(" %.3f |", median(it->second));
+        std::printf(" %.3f |", medianOrNan(it->second));
     }
     std::printf("\n");
   }

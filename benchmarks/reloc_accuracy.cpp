@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "ellreloc/core/evaluation.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/sim/noise.hpp"
@@ -15,12 +16,6 @@
 using namespace ellreloc;
 
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 /// A simulated IMU: the map's up seen from the true pose, tilted by `sigma_deg` of noise.
 GravityPrior simulatedImu(const Eigen::Vector3d& up_in_map, const Pose& truth, double sigma_deg, std::mt19937& rng) {
@@ -34,8 +29,8 @@ GravityPrior simulatedImu(const Eigen::Vector3d& up_in_map, const Pose& truth, d
 void evaluate(const char* name, const bench::RelocalizationDataset& d, const RelocalizerOptions& opt,
               bool gravity = false) {
   const ObjectRelocalizer reloc(d.map, d.K, opt);
-  std::vector<double> pos, rot, times;
-  int valid = 0;
+  std::vector<double> times;
+  std::vector<std::optional<PoseError>> errors;
   double max_time = 0.0;
   long hyps = 0;
   std::mt19937 imu_rng(7);
@@ -46,17 +41,12 @@ void evaluate(const char* name, const bench::RelocalizationDataset& d, const Rel
     times.push_back(r.time_ms);
     max_time = std::max(max_time, r.time_ms);
     hyps += r.hypotheses;
-    if (r.status != RelocalizationStatus::Success) continue;
-    const double pe = (r.pose.center() - q.truth.center()).norm();
-    const double re = rotationErrorDeg(r.pose.rotation(), q.truth.rotation());
-    if (pe < 0.3 && re < 30.0) {
-      ++valid;
-      pos.push_back(pe);
-      rot.push_back(re);
-    }
+    errors.push_back(r.status == RelocalizationStatus::Success ? std::optional(poseError(r.pose, q.truth))
+                                                               : std::nullopt);
   }
+  const RelocalizationSummary s = summarize(errors);
   std::printf("| %-16s | %-32s | %5.1f%% | %6.1f cm | %5.2f deg | %8.2f ms | %8.1f ms | %8ld |\n", d.name.c_str(), name,
-              100.0 * valid / d.queries.size(), 100.0 * median(pos), median(rot), median(times), max_time,
+              s.validPercent(), s.median_position_cm, s.median_rotation_deg, median(times), max_time,
               hyps / static_cast<long>(d.queries.size()));
 }
 

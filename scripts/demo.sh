@@ -5,4 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh
-"${ELLRELOC_BUILD_DIR:-build}/examples/cli/ellreloc" demo "$@"
+"${ELLRELOC_BUILD_DIR:-build}/apps/ellreloc/ellreloc" demo "$@"

@@ -9,6 +9,7 @@
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/projection.hpp"
+#include "ellreloc/core/statistics.hpp"
 
 namespace ellreloc {
 namespace {
@@ -60,11 +61,6 @@ Box boundingBox(const Ellipse& e) {
   return Box(e.center().x() - hx, e.center().y() - hy, e.center().x() + hx, e.center().y() + hy);
 }
 
-double medianOf(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 }  // namespace
 
@@ -153,7 +149,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
     radii.push_back(0.25 * (v.box.width() / K.fx + v.box.height() / K.fy) * z);
   }
   double c[3] = {centre->x(), centre->y(), centre->z()};
-  const double log_r = std::log(std::max(1e-3, medianOf(radii)));
+  const double log_r = std::log(std::max(1e-3, median(radii)));
   double s[3] = {log_r, log_r, log_r};
   double w[3] = {0.0, 0.0, 0.0};
 
@@ -188,7 +184,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
     const Projection p = project(out.ellipsoid, K, v.pose);
     ious.push_back(p ? boxIoU(boundingBox(p.ellipse), v.box) : 0.0);
   }
-  out.median_iou = medianOf(ious);
+  out.median_iou = median(ious);
   if (out.median_iou < options.min_median_iou) {
     out.status = BoxEllipsoidStatus::PoorFit;
     out.reason = "median reprojection IoU " + std::to_string(out.median_iou);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
 
 namespace ellreloc {
@@ -61,14 +62,11 @@ std::pair<double, double> VoxelObject::depthGate(const DepthImage& depth, const 
       if (v >= options_.min_depth && v <= options_.max_depth) d.push_back(v);
     }
   if (d.empty()) return range;
-  const auto mid = d.begin() + static_cast<long>(d.size() / 2);
-  std::nth_element(d.begin(), mid, d.end());
-  const double median = *mid;
-  for (double& v : d) v = std::abs(v - median);
-  std::nth_element(d.begin(), mid, d.end());
-  const double sigma = 1.4826 * *mid;  // the MAD of a Gaussian is 0.6745 sigma
+  const double centre = median(d);
+  for (double& v : d) v = std::abs(v - centre);
+  const double sigma = 1.4826 * median(d);  // the MAD of a Gaussian is 0.6745 sigma
   const double half = std::max(options_.depth_gate_min, options_.depth_gate_sigmas * sigma);
-  return {std::max(range.first, median - half), std::min(range.second, median + half)};
+  return {std::max(range.first, centre - half), std::min(range.second, centre + half)};
 }
 
 uint64_t VoxelObject::pack(int x, int y, int z) {

@@ -161,10 +161,12 @@ struct RelocalizerOptions {
     if (refinement.top_k < 1 || refinement.rounds < 0) return "refinement.top_k below 1 or refinement.rounds negative";
     if (!(refinement.cost_margin >= 0)) return "refinement.cost_margin is negative or not a number";
     const RefinerOptions& r = refinement.refiner;
-    if (!(finite(r.object_loss_scale) && r.object_loss_scale > 0) || !(finite(r.point_sigma_px) && r.point_sigma_px > 0) ||
+    if (!(finite(r.object_loss_scale) && r.object_loss_scale > 0) ||
+        !(finite(r.point_sigma_px) && r.point_sigma_px > 0) ||
         !(finite(r.point_loss_scale) && r.point_loss_scale > 0) || !(finite(r.point_weight) && r.point_weight >= 0))
       return "refinement.refiner has a non-positive or non-finite scale or weight";
-    if (r.max_iterations < 0 || !(r.function_tolerance >= 0)) return "refinement.refiner has a negative tolerance or count";
+    if (r.max_iterations < 0 || !(r.function_tolerance >= 0))
+      return "refinement.refiner has a negative tolerance or count";
     return "";
   }
 };

@@ -112,8 +112,9 @@ void HypothesisEstimator::fromTwoPairs(int a, int b, const std::optional<Gravity
 }
 
 void HypothesisEstimator::fromOnePair(int a, const GravityPrior& gravity, std::vector<Model>* out) const {
-  fromSolver(posesFromOneObject(K_, ellipseMatchOf(pairs_[a], observations_, map_), gravity, options_.few_objects.solver),
-             &a, 1, out);
+  fromSolver(
+      posesFromOneObject(K_, ellipseMatchOf(pairs_[a], observations_, map_), gravity, options_.few_objects.solver), &a,
+      1, out);
 }
 
 }  // namespace ellreloc::pipeline

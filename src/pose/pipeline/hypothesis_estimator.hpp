@@ -36,10 +36,15 @@ class HypothesisEstimator {
   static constexpr int kSampleSize = 3;
   static constexpr int kMaxModels = 4;
 
-  HypothesisEstimator(const std::vector<Observation>& observations, const Candidates& candidates,
-                      const ObjectMap& map, const Intrinsics& K, const RelocalizerOptions& options,
-                      const GravityGate& gate, PoseScorer& scorer)
-      : observations_(observations), pairs_(candidates.pairs), map_(map), K_(K), options_(options), gate_(gate),
+  HypothesisEstimator(const std::vector<Observation>& observations, const Candidates& candidates, const ObjectMap& map,
+                      const Intrinsics& K, const RelocalizerOptions& options, const GravityGate& gate,
+                      PoseScorer& scorer)
+      : observations_(observations),
+        pairs_(candidates.pairs),
+        map_(map),
+        K_(K),
+        options_(options),
+        gate_(gate),
         scorer_(scorer) {}
 
   // The RANSAC estimator concept (core/ransac.hpp) over candidate pairs.

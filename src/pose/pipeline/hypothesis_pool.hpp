@@ -37,7 +37,8 @@ class HypothesisPool {
 
  private:
   void sortByCost() {
-    std::sort(entries_.begin(), entries_.end(), [](const ScoredPose& x, const ScoredPose& y) { return x.cost < y.cost; });
+    std::sort(entries_.begin(), entries_.end(),
+              [](const ScoredPose& x, const ScoredPose& y) { return x.cost < y.cost; });
   }
   size_t capacity_;
   std::vector<ScoredPose> entries_;

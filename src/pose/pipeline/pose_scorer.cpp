@@ -7,8 +7,8 @@
 
 namespace ellreloc::pipeline {
 
-PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candidates& candidates,
-                       const ObjectMap& map, const Intrinsics& K, const ScoringOptions& options)
+PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candidates& candidates, const ObjectMap& map,
+                       const Intrinsics& K, const ScoringOptions& options)
     : observations_(observations), candidates_(candidates), map_(map), K_(K), options_(options) {
   const auto& cands = candidates.of_observation;
   std::vector<char> relevant(map.objects.size(), 0);
@@ -61,14 +61,14 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
       const Box pb = projected_[j].boundingBox();
       if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
       const double ov = options_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, pb)
-                                                                    : ellipseIoU(o.ellipse, projected_[j], vertices);
-      if (ov >= options_.min_overlap)
-        all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
+                                                                   : ellipseIoU(o.ellipse, projected_[j], vertices);
+      if (ov >= options_.min_overlap) all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
     }
   }
   std::sort(all_matches_.begin(), all_matches_.end(), [](const ObjectCorrespondence& a, const ObjectCorrespondence& b) {
-    return a.credit != b.credit ? a.credit > b.credit
-                                : (a.observation != b.observation ? a.observation < b.observation : a.object < b.object);
+    return a.credit != b.credit
+               ? a.credit > b.credit
+               : (a.observation != b.observation ? a.observation < b.observation : a.object < b.object);
   });
   std::fill(observation_taken_.begin(), observation_taken_.end(), 0);
   std::fill(object_taken_.begin(), object_taken_.end(), 0);

@@ -8,8 +8,7 @@ namespace ellreloc::pipeline {
 namespace {
 
 /// The budgets of options.search for this frame.
-RansacOptions frameBudget(const SearchOptions& search, HypothesisSampler sampler, size_t num_objects,
-                          int num_usable) {
+RansacOptions frameBudget(const SearchOptions& search, HypothesisSampler sampler, size_t num_objects, int num_usable) {
   RansacOptions budget = search.budget;
   // Scoring a hypothesis costs up to (map objects) x (usable observations) overlaps: a large map
   // with many observations gets fewer hypotheses, so that the worst case stays bounded.

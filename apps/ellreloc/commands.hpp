@@ -1,12 +1,22 @@
 #pragma once
-// The `ellreloc` subcommands as plain functions, so that `demo` can chain them. Each throws
-// ellreloc::Error on bad input (main turns it into one line and exit code 2).
+// The `ellreloc` subcommands, one file each: add<Name>Command registers the options, the plain
+// function runs it (so that `demo` can chain them). Each throws ellreloc::Error on bad input
+// (main turns it into one line and exit code 2).
 
 #include <string>
 #include <vector>
 
+#include "ellreloc/core/evaluation.hpp"
+#include "ellreloc/error.hpp"
+#include "ellreloc/observe/observe.hpp"
+
+namespace CLI {
+class App;
+}
+
 namespace ellreloc::cli {
 
+/// Where progress goes: a bar on a terminal, nothing when quiet.
 struct Console {
   bool quiet = false;
   /// A progress bar on stderr, only when stderr is a terminal and not quiet.
@@ -19,16 +29,21 @@ struct SimulateArgs {
   unsigned long seed = 1;
   int mapping_frames = 60, query_frames = 100;
 };
+CLI::App* addSimulateCommand(CLI::App& app, SimulateArgs& a);
 void simulate(const SimulateArgs& a, const Console& console);
 
 struct ObserveArgs {
   std::string camera, detections, policy = "paper", out;
 };
+CLI::App* addObserveCommand(CLI::App& app, ObserveArgs& a);
 void observe(const ObserveArgs& a, const Console& console);
+/// paper, bbox, mask or given; anything else is an Error naming --policy.
+ObservationPolicy parsePolicy(const std::string& name);
 
 struct MapArgs {
   std::string camera, associations, trajectory, detections, mode = "voxel", out;
 };
+CLI::App* addMapCommand(CLI::App& app, MapArgs& a);
 void map(const MapArgs& a, const Console& console);
 
 struct RelocalizeArgs {
@@ -39,25 +54,24 @@ struct RelocalizeArgs {
   std::vector<double> camera_up, map_up;  ///< a gravity prior for every frame, when both are given
   double gravity_sigma_deg = 2.0;
 };
+/// `use_points` is set after parsing, from whether --points was given.
+CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a);
 /// Returns the number of frames relocalized.
 int relocalize(const RelocalizeArgs& a, const Console& console);
 
 struct EvaluateArgs {
   std::string groundtruth, estimate, detections, plot;
 };
-struct Evaluation {
-  int frames = 0, relocalized = 0, valid = 0;
-  double median_position_cm = 0.0, median_rotation_deg = 0.0;
-  double validPercent() const { return frames > 0 ? 100.0 * valid / frames : 0.0; }
-};
-Evaluation evaluate(const EvaluateArgs& a);
-void printEvaluation(const Evaluation& e);
+CLI::App* addEvaluateCommand(CLI::App& app, EvaluateArgs& a);
+RelocalizationSummary evaluate(const EvaluateArgs& a);
+void printEvaluation(const RelocalizationSummary& e);
 
 struct DemoArgs {
   std::string out;
   unsigned long seed = 1;
   int threads = 2;
 };
+CLI::App* addDemoCommand(CLI::App& app, DemoArgs& a);
 void demo(const DemoArgs& a, const Console& console);
 
 }  // namespace ellreloc::cli

@@ -1,0 +1,102 @@
+// `ellreloc map`.
+
+#include "ellreloc/io/map.hpp"
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "commands.hpp"
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/io/trajectory.hpp"
+#include "ellreloc/mapping/mapper.hpp"
+
+namespace fs = std::filesystem;
+
+namespace ellreloc::cli {
+
+namespace {
+
+std::string absoluteNormal(const fs::path& p) { return fs::absolute(p).lexically_normal().string(); }
+
+}  // namespace
+
+CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
+  CLI::App* m = app.add_subcommand("map", "build an object map from keyframes (docs/mapping.md)");
+  m->add_option("--camera", a.camera, "camera intrinsics: ORB-SLAM YAML or JSON")->required()->check(CLI::ExistingFile);
+  m->add_option("--associations", a.associations, "TUM association file (voxel mode: the depth images)")
+      ->check(CLI::ExistingFile);
+  m->add_option("--trajectory", a.trajectory, "TUM trajectory of the keyframes (camera->world)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  m->add_option("--detections", a.detections, "detections with masks (voxel) or boxes")
+      ->required()
+      ->check(CLI::ExistingFile);
+  m->add_option("--mode", a.mode, "voxel (RGB-D + masks) or boxes (boxes and poses only)")->capture_default_str();
+  m->add_option("--out", a.out, "output map JSON")->required();
+  m->footer(
+      "Example: ellreloc map --camera S/camera.yaml --associations S/mapping/associations.txt --trajectory "
+      "S/mapping/trajectory.txt --detections S/mapping/detections.json --mode voxel --out map.json");
+  return m;
+}
+
+void map(const MapArgs& a, const Console& console) {
+  const Intrinsics K = io::readCamera(a.camera);
+  MapperOptions options;
+  if (!parseMappingMode(a.mode, &options.mode)) throw Error("--mode: unknown mode '" + a.mode + "' (voxel, boxes)");
+  const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
+  const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
+  std::vector<io::Association> associations;
+  if (!a.associations.empty()) associations = io::readAssociations(a.associations);
+  if (options.mode == MappingMode::Voxel && associations.empty())
+    throw Error(a.associations.empty() ? std::string("--associations: voxel mode needs the depth images")
+                                       : a.associations + ": no association");
+  const fs::path detections_dir = fs::path(a.detections).parent_path();
+
+  Mapper mapper(K, options);
+  int used = 0, no_pose = 0, no_depth = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const DetectionFrame& f = frames[i];
+    // The frame's depth: the association naming the same colour image, else the same time.
+    const std::string rgb = absoluteNormal(detections_dir / f.file_name);
+    const io::Association* assoc = nullptr;
+    for (const io::Association& as : associations)
+      if (absoluteNormal(as.rgb_path) == rgb) assoc = &as;
+    const std::optional<double> t = assoc ? std::optional<double>(assoc->rgb_time) : f.timestamp();
+    if (!assoc && t)
+      for (const io::Association& as : associations)
+        if (std::abs(as.rgb_time - *t) <= 0.02) assoc = &as;
+    const std::optional<size_t> k = t ? io::findNearest(trajectory, *t) : std::nullopt;
+    if (!k) {
+      ++no_pose;
+      continue;
+    }
+    DepthImage depth;
+    if (options.mode == MappingMode::Voxel) {
+      if (!assoc) {
+        ++no_depth;
+        continue;
+      }
+      depth = io::readDepthPng(assoc->depth_path);
+    }
+    try {
+      mapper.addKeyframe(trajectory[*k].pose, f.detections, options.mode == MappingMode::Voxel ? &depth : nullptr);
+    } catch (const Error& e) {
+      throw Error(a.detections + ": " + f.file_name + ": " + e.what());
+    }
+    ++used;
+    console.progress("map", i + 1, frames.size());
+  }
+  console.endProgress();
+  if (used == 0) throw Error(a.detections + ": no frame has both a pose in " + a.trajectory + " and its depth");
+  const ObjectMap result = mapper.map();
+  io::writeMap(a.out, result);
+  if (!console.quiet)
+    std::printf("wrote %s: %zu objects from %d keyframes (%s mode; %d frames without pose, %d without depth)\n",
+                a.out.c_str(), result.objects.size(), used, a.mode.c_str(), no_pose, no_depth);
+}
+
+}  // namespace ellreloc::cli

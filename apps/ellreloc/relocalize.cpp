@@ -1,0 +1,149 @@
+// `ellreloc relocalize`.
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "commands.hpp"
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/files.hpp"
+#include "ellreloc/io/map.hpp"
+#include "ellreloc/io/trajectory.hpp"
+#include "ellreloc/observe/observe.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+
+namespace ellreloc::cli {
+
+CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
+  CLI::App* r = app.add_subcommand("relocalize", "recover the camera pose of each frame from its detections");
+  r->add_option("--camera", a.camera, "camera intrinsics: ORB-SLAM YAML or JSON")->required()->check(CLI::ExistingFile);
+  r->add_option("--map", a.map, "map JSON or OA-SLAM text map")->required()->check(CLI::ExistingFile);
+  r->add_option("--detections", a.detections, "detections JSON: the query frames (docs/formats.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  r->add_option("--method", a.method, "ours or oa-slam (the OA-SLAM baseline)")->capture_default_str();
+  r->add_option("--policy", a.policy, "observation policy (default: paper for ours, bbox for oa-slam)");
+  r->add_option("--out", a.out, "TUM poses of the relocalized frames")->required();
+  r->add_option("--report", a.report, "per-frame JSON report: status, inliers, score, time");
+  r->add_option("--points", a.points,
+                "refine with keypoints matched to the map's points: from this file (same frame "
+                "layout), or from the detections file when no file is given")
+      ->expected(0, 1);
+  r->add_option("--threads", a.threads, "frames in parallel")->capture_default_str()->check(CLI::Range(1, 256));
+  auto* camera_up = r->add_option("--camera-up", a.camera_up,
+                                  "gravity prior: the up direction in the camera frame (x right, y down, z forward), "
+                                  "for a camera at a fixed tilt, e.g. 0,-1,0 for a level camera")
+                        ->expected(3)
+                        ->delimiter(',');
+  auto* map_up = r->add_option("--map-up", a.map_up, "gravity prior: the up direction in the map frame, e.g. 0,0,1")
+                     ->expected(3)
+                     ->delimiter(',');
+  camera_up->needs(map_up);
+  map_up->needs(camera_up);
+  r->add_option("--gravity-sigma", a.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
+      ->capture_default_str()
+      ->needs(camera_up);
+  r->footer(
+      "Example: ellreloc relocalize --camera camera.yaml --map map.json --detections keyframes.detections.json "
+      "--method ours --out poses.txt --report report.json --threads 2");
+  return r;
+}
+
+int relocalize(const RelocalizeArgs& a, const Console& console) {
+  const Intrinsics K = io::readCamera(a.camera);
+  const ObjectMap object_map = io::readMap(a.map);
+  const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
+  RelocalizerOptions options;
+  std::string policy = a.policy;
+  if (a.method == "oa-slam") {
+    options = RelocalizerOptions::oaSlam();
+    if (policy.empty()) policy = "bbox";
+  } else if (a.method != "ours") {
+    throw Error("--method: unknown method '" + a.method + "' (ours, oa-slam)");
+  }
+  ObserveOptions observe_options;
+  observe_options.policy = parsePolicy(policy.empty() ? "paper" : policy);
+  const ObjectRelocalizer relocalizer(object_map, K, options);
+  std::optional<GravityPrior> gravity;
+  if (a.camera_up.size() == 3 && a.map_up.size() == 3) {
+    gravity = GravityPrior{
+        {a.camera_up[0], a.camera_up[1], a.camera_up[2]}, {a.map_up[0], a.map_up[1], a.map_up[2]}, a.gravity_sigma_deg};
+    if (!gravity->isValid())
+      throw Error("--camera-up/--map-up/--gravity-sigma: directions must be finite and non-zero, sigma positive");
+  }
+  // Keypoints per frame: from the detections file itself, or from a file with the same frames.
+  std::vector<std::vector<Keypoint>> keypoints(frames.size());
+  if (a.use_points) {
+    if (object_map.points.empty()) throw Error(a.map + ": --points needs a map with `points`");
+    std::map<std::string, std::vector<Keypoint>> by_name;
+    if (!a.points.empty())
+      for (const DetectionFrame& f : io::readDetections(a.points)) by_name[f.file_name] = f.keypoints;
+    for (size_t i = 0; i < frames.size(); ++i)
+      keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
+  }
+
+  // Frames are independent: workers take the next frame until none is left.
+  std::vector<RelocalizationResult> results(frames.size());
+  std::vector<int> observed(frames.size(), 0);
+  std::atomic<size_t> next(0), finished(0);
+  const auto work = [&] {
+    for (size_t i = next++; i < frames.size(); i = next++) {
+      std::vector<Observation> observations;
+      for (const Detection& d : frames[i].detections)
+        if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
+          observations.push_back(*r.observation);
+      observed[i] = static_cast<int>(observations.size());
+      results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
+      ++finished;
+    }
+  };
+  std::vector<std::thread> workers;
+  for (int t = 1; t < a.threads; ++t) workers.emplace_back(work);
+  if (a.threads <= 1) {
+    work();
+  } else {
+    while (finished < frames.size()) {
+      console.progress("relocalize", finished, frames.size());
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+  for (std::thread& w : workers) w.join();
+  console.endProgress();
+
+  std::vector<io::StampedPose> poses;
+  nlohmann::json report = nlohmann::json::array();
+  std::vector<double> times;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const RelocalizationResult& r = results[i];
+    times.push_back(r.time_ms);
+    nlohmann::json j = {{"file_name", frames[i].file_name}, {"status", toString(r.status)}, {"reason", r.reason},
+                        {"observations", observed[i]},      {"inliers", r.inliers.size()},  {"score", r.cost},
+                        {"mean_overlap", r.mean_overlap},   {"hypotheses", r.hypotheses},   {"time_ms", r.time_ms}};
+    nlohmann::json matches = nlohmann::json::array();
+    for (const ObjectCorrespondence& c : r.inliers)
+      matches.push_back({{"observation", c.observation},
+                         {"object_id", object_map.objects[static_cast<size_t>(c.object)].id},
+                         {"overlap", c.overlap}});
+    j["matches"] = matches;
+    report.push_back(j);
+    if (r.status != RelocalizationStatus::Success) continue;
+    const std::optional<double> t = frames[i].timestamp();
+    if (!t)
+      throw Error(a.detections + ": [" + std::to_string(i) + "].file_name: '" + frames[i].file_name +
+                  "' has no numeric base name to use as a timestamp");
+    poses.push_back({*t, r.pose});
+  }
+  io::writeTumTrajectory(a.out, poses);
+  if (!a.report.empty()) io::writeFileAtomically(a.report, report.dump(1) + "\n");
+  if (!console.quiet)
+    std::printf("wrote %s: %zu of %zu frames relocalized (%s), median %.1f ms per frame\n", a.out.c_str(), poses.size(),
+                frames.size(), a.method.c_str(), median(times));
+  return static_cast<int>(poses.size());
+}
+
+}  // namespace ellreloc::cli
