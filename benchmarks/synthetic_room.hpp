@@ -9,6 +9,7 @@
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/core/observation.hpp"
+#include "ellreloc/sim/map_observations.hpp"
 
 namespace ellreloc::bench {
 
@@ -42,22 +43,11 @@ inline Room makeRoom(int n, int categories, int cameras, uint32_t seed) {
 
 /// Observations of up to `max_obs` visible objects with 1 px of centre noise and 3% axis noise.
 inline std::vector<Observation> observe(const Room& room, const Pose& pose, int max_obs, std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::vector<Observation> out;
-  for (const MapObject& m : room.map.objects) {
-    const Projection p = project(m.ellipsoid, kK, pose);
-    if (!p) continue;
-    const Box b = p.ellipse.boundingBox();
-    if (b.x1 < 0 || b.y1 < 0 || b.x2 > kK.width || b.y2 > kK.height) continue;
-    Observation o;
-    o.category = m.category;
-    o.ellipse = Ellipse(p.ellipse.center() + Eigen::Vector2d(g(rng), g(rng)), p.ellipse.axes() * (1.0 + 0.03 * g(rng)),
-                        p.ellipse.angle());
-    o.box = o.ellipse.boundingBox();
-    out.push_back(o);
-    if (static_cast<int>(out.size()) == max_obs) break;
-  }
-  return out;
+  sim::MapObservationOptions noise;
+  noise.centre_sigma_px = 1.0;
+  noise.axis_sigma = 0.03;
+  noise.max_observations = max_obs;
+  return sim::observeMap(room.map, kK, pose, noise, &rng);
 }
 
 }  // namespace ellreloc::bench

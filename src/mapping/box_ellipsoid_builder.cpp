@@ -50,16 +50,6 @@ struct BoxW2Cost {
   }
 };
 
-bool touchesBorder(const Box& b, const Intrinsics& K, double border) {
-  return b.x1 <= -0.5 + border || b.y1 <= -0.5 + border || b.x2 >= K.width - 0.5 - border ||
-         b.y2 >= K.height - 0.5 - border;
-}
-
-Box boundingBox(const Ellipse& e) {
-  const Eigen::Matrix2d S = e.covariance();
-  const double hx = std::sqrt(S(0, 0)), hy = std::sqrt(S(1, 1));
-  return Box(e.center().x() - hx, e.center().y() - hy, e.center().x() + hx, e.center().y() + hy);
-}
 
 
 }  // namespace
@@ -113,7 +103,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
   for (const BoxView& v : all_views) {
     if (!v.pose.isValid() || !v.box.isValid() || !(v.box.area() > 1.0)) continue;
     valid.push_back(v);
-    if (!touchesBorder(v.box, K, options.border_px)) inside.push_back(v);
+    if (!v.box.nearImageBorder(K.width, K.height, options.border_px)) inside.push_back(v);
   }
   const std::vector<BoxView>& views = inside.size() >= options.min_views ? inside : valid;
   out.views_used = static_cast<int>(views.size());
@@ -182,7 +172,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
   std::vector<double> ious;
   for (const BoxView& v : views) {
     const Projection p = project(out.ellipsoid, K, v.pose);
-    ious.push_back(p ? boxIoU(boundingBox(p.ellipse), v.box) : 0.0);
+    ious.push_back(p ? boxIoU(p.ellipse.boundingBox(), v.box) : 0.0);
   }
   out.median_iou = median(ious);
   if (out.median_iou < options.min_median_iou) {

@@ -16,12 +16,6 @@ bool boxFinite(const Box& b) {
   return std::isfinite(b.x1) && std::isfinite(b.y1) && std::isfinite(b.x2) && std::isfinite(b.y2);
 }
 
-/// The axis-aligned box of an ellipse (shape matrix diagonal = squared half-widths).
-Box ellipseBox(const Ellipse& e) {
-  const Eigen::Matrix2d S = e.covariance();
-  const double hx = std::sqrt(S(0, 0)), hy = std::sqrt(S(1, 1));
-  return Box(e.center().x() - hx, e.center().y() - hy, e.center().x() + hx, e.center().y() + hy);
-}
 
 }  // namespace
 
@@ -150,24 +144,18 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
   }
 
   // 2D tracking against the objects seen in the last keyframes, by their projected voxels.
-  std::vector<size_t> recent;
-  std::vector<LabelledBox> object_boxes;
+  std::vector<std::pair<size_t, Box>> expected;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (keyframes_ - tracks_[i].last_seen > options_.track_window) continue;
-    const auto box = tracks_[i].voxels.projectedBox(K_, pose);
-    if (!box) continue;
-    recent.push_back(i);
-    object_boxes.push_back({*box, tracks_[i].label()});
+    if (const auto box = tracks_[i].voxels.projectedBox(K_, pose)) expected.emplace_back(i, *box);
   }
-  std::vector<LabelledBox> detection_boxes;
-  for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id});
-  const std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking);
+  const std::vector<int> tracked = associate2D(expected, detections, used);
 
   for (size_t k = 0; k < used.size(); ++k) {
     const Detection& d = detections[used[k]];
     ++report->used;
     if (tracked[k] >= 0) {
-      Track& t = tracks_[recent[static_cast<size_t>(tracked[k])]];
+      Track& t = tracks_[static_cast<size_t>(tracked[k])];
       t.voxels.integrate(K_, pose, depth, masks[k]);
       observed(t, d);
       ++report->tracked_2d;
@@ -203,6 +191,17 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
   }
 }
 
+std::vector<int> Mapper::associate2D(const std::vector<std::pair<size_t, Box>>& expected,
+                                     const std::vector<Detection>& detections, const std::vector<size_t>& used) const {
+  std::vector<LabelledBox> object_boxes, detection_boxes;
+  for (const auto& [track, box] : expected) object_boxes.push_back({box, tracks_[track].label()});
+  for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id});
+  std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking);
+  for (int& t : tracked)
+    if (t >= 0) t = static_cast<int>(expected[static_cast<size_t>(t)].first);
+  return tracked;
+}
+
 void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report) {
   std::vector<size_t> used;
   for (size_t j = 0; j < detections.size(); ++j) {
@@ -215,8 +214,7 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
   // A track's expected box: the projection of its ellipsoid into this keyframe once it has
   // one (it follows the camera's motion), else its last box when seen in the last keyframes,
   // else the projection of a sphere at its triangulated centre.
-  std::vector<size_t> candidates;
-  std::vector<LabelledBox> object_boxes;
+  std::vector<std::pair<size_t, Box>> expected_boxes;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
     std::optional<Box> expected;
@@ -233,21 +231,17 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     }
     if (e) {
       const Projection p = project(*e, K_, pose);
-      if (p) expected = ellipseBox(p.ellipse);
+      if (p) expected = p.ellipse.boundingBox();
     }
-    if (!expected) continue;
-    candidates.push_back(i);
-    object_boxes.push_back({*expected, t.label()});
+    if (expected) expected_boxes.emplace_back(i, *expected);
   }
-  std::vector<LabelledBox> detection_boxes;
-  for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id});
-  const std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking);
+  const std::vector<int> tracked = associate2D(expected_boxes, detections, used);
   for (size_t k = 0; k < used.size(); ++k) {
     const Detection& d = detections[used[k]];
     ++report->used;
     Track* t = nullptr;
     if (tracked[k] >= 0) {
-      t = &tracks_[candidates[static_cast<size_t>(tracked[k])]];
+      t = &tracks_[static_cast<size_t>(tracked[k])];
       ++report->tracked_2d;
     } else {
       tracks_.emplace_back();

@@ -5,6 +5,7 @@
 #include "../random_geometry.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/sim/map_observations.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::positionError;
@@ -24,7 +25,6 @@ struct Synthetic {
 
 Synthetic makeScene(std::mt19937& rng, int n, int categories, double centre_noise_px = 0.0) {
   const Intrinsics K = test::testIntrinsics();
-  std::normal_distribution<double> normal(0.0, 1.0);
   Synthetic s;
   for (int i = 0; i < n; ++i) {
     const double yaw = uniform(rng, -M_PI, M_PI);
@@ -34,20 +34,9 @@ Synthetic makeScene(std::mt19937& rng, int n, int categories, double centre_nois
                                        Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix())});
   }
   s.truth = test::randomLookAtPose(rng);
-  for (int j = 0; j < n; ++j) {
-    const Projection p = project(s.map.objects[j].ellipsoid, K, s.truth);
-    if (!p) continue;
-    const Box b = p.ellipse.boundingBox();
-    if (b.x1 < 0 || b.y1 < 0 || b.x2 > K.width || b.y2 > K.height) continue;
-    Observation o;
-    o.category = s.map.objects[j].category;
-    o.ellipse = Ellipse(p.ellipse.center() + centre_noise_px * Eigen::Vector2d(normal(rng), normal(rng)),
-                        p.ellipse.axes(), p.ellipse.angle());
-    o.box = o.ellipse.boundingBox();
-    o.source = EllipseSource::Given;
-    s.observations.push_back(o);
-    s.object_of.push_back(j);
-  }
+  sim::MapObservationOptions noise;
+  noise.centre_sigma_px = centre_noise_px;
+  s.observations = sim::observeMap(s.map, K, s.truth, noise, &rng, &s.object_of);
   return s;
 }
 
@@ -190,17 +179,9 @@ TEST(ObjectRelocalizer, DeterministicAndThreadSafe) {
   const ObjectRelocalizer reloc(scenes[0].map, K);
   std::vector<std::vector<Observation>> queries;
   for (const Synthetic& s : scenes) {
-    std::vector<Observation> q;
-    for (const MapObject& m : scenes[0].map.objects) {
-      const Projection p = project(m.ellipsoid, K, s.truth);
-      if (!p) continue;
-      Observation o;
-      o.category = m.category;
-      o.ellipse = p.ellipse;
-      o.box = p.ellipse.boundingBox();
-      q.push_back(o);
-    }
-    queries.push_back(q);
+    sim::MapObservationOptions every;
+    every.inside_image_only = false;
+    queries.push_back(sim::observeMap(scenes[0].map, K, s.truth, every));
   }
   std::vector<RelocalizationResult> serial;
   for (const auto& q : queries) serial.push_back(reloc.relocalize(q));
@@ -246,18 +227,9 @@ TEST(ObjectRelocalizer, SymmetricLayoutsAreExplainedAndBrokenByOneDistinctObject
         {k, 41, "cup", Ellipsoid({0.5 * (k & 1 ? 1 : -1), 0.5 * (k & 2 ? 1 : -1), 0.0}, {0.06, 0.06, 0.09}, I)});
   const Pose truth = Pose::fromCameraToWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix(),
                                              Eigen::Vector3d(0.05, 0.02, 3.0));  // looking down the axis
-  auto observe = [&](const ObjectMap& m) {
-    std::vector<Observation> obs;
-    for (const MapObject& o : m.objects) {
-      const Projection p = project(o.ellipsoid, K, truth);
-      Observation ob;
-      ob.category = o.category;
-      ob.ellipse = p.ellipse;
-      ob.box = p.ellipse.boundingBox();
-      obs.push_back(ob);
-    }
-    return obs;
-  };
+  sim::MapObservationOptions every;
+  every.inside_image_only = false;
+  auto observe = [&](const ObjectMap& m) { return sim::observeMap(m, K, truth, every); };
   const RelocalizationResult sym = ObjectRelocalizer(map, K).relocalize(observe(map));
   ASSERT_EQ(sym.status, RelocalizationStatus::Success);
   EXPECT_EQ(sym.inliers.size(), 4u);  // some symmetric copy of the pose explains all four

@@ -34,6 +34,13 @@ struct Box {
     if (r.y2 < r.y1) r.y2 = r.y1;
     return r;
   }
+
+  /// Within `border_px` of the border of a width x height image (pixel centres at integers, so
+  /// the image spans [-0.5, width - 0.5]): the object it bounds may be cut off by the border.
+  bool nearImageBorder(int width, int height, double border_px) const {
+    return x1 <= -0.5 + border_px || y1 <= -0.5 + border_px || x2 >= width - 0.5 - border_px ||
+           y2 >= height - 0.5 - border_px;
+  }
 };
 
 /// Intersection over union of two boxes, in [0, 1]; 0 when either box is invalid or empty.

@@ -39,8 +39,7 @@ inline std::optional<Observation> observationFromBox(int category, double score,
   o.ellipse = *e;
   o.box = box;
   o.source = EllipseSource::Box;
-  o.truncated = box.x1 <= -0.5 + border_px || box.y1 <= -0.5 + border_px || box.x2 >= width - 0.5 - border_px ||
-                box.y2 >= height - 0.5 - border_px;
+  o.truncated = box.nearImageBorder(width, height, border_px);
   return o;
 }
 

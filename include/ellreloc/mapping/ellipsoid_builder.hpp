@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "ellreloc/core/ellipsoid.hpp"
+#include "ellreloc/core/statistics.hpp"
 
 namespace ellreloc {
 
@@ -64,15 +65,17 @@ struct BuiltEllipsoid {
 };
 
 namespace detail {
-/// The q-quantile of values (0 <= q <= 1), linear interpolation between order statistics.
-inline double quantile(std::vector<double> values, double q) {
-  const double pos = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(pos));
-  std::nth_element(values.begin(), values.begin() + static_cast<long>(lo), values.end());
-  const double a = values[lo];
-  if (lo + 1 >= values.size()) return a;
-  const double b = *std::min_element(values.begin() + static_cast<long>(lo) + 1, values.end());
-  return a + (pos - static_cast<double>(lo)) * (b - a);
+/// The percentile rectangle of ground-plane points along `main` and across it (lo, hi in
+/// (along, across) coordinates); `along` and `across` receive every point's coordinates.
+inline void percentileRectangle(const std::vector<Eigen::Vector2d>& ground, const Eigen::Vector2d& main,
+                                double low, double high, std::vector<double>* along, std::vector<double>* across,
+                                Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
+  const Eigen::Vector2d side(-main.y(), main.x());
+  along->resize(ground.size());
+  across->resize(ground.size());
+  for (size_t i = 0; i < ground.size(); ++i) (*along)[i] = main.dot(ground[i]), (*across)[i] = side.dot(ground[i]);
+  *lo = Eigen::Vector2d(interpolatedQuantile(*along, low), interpolatedQuantile(*across, low));
+  *hi = Eigen::Vector2d(interpolatedQuantile(*along, high), interpolatedQuantile(*across, high));
 }
 /// The direction of the longer side of the smallest-area rectangle enclosing 2D points: the
 /// rectangle has a side on an edge of the convex hull, so each hull edge is tried.
@@ -146,6 +149,7 @@ inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vec
   }
   std::vector<char> inlier(points.size(), 1);
   Eigen::Vector2d main, lo, hi;
+  std::vector<double> along, across;
   for (int pass = 0; pass < 2; ++pass) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     double n = 0.0;
@@ -158,13 +162,8 @@ inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vec
       if (inlier[i]) cov += (ground[i] - mean) * (ground[i] - mean).transpose();
     if (!cov.allFinite()) return std::nullopt;
     main = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvectors().col(1);  // largest eigenvalue
-    const Eigen::Vector2d side(-main.y(), main.x());
-    std::vector<double> along(ground.size()), across(ground.size());
-    for (size_t i = 0; i < ground.size(); ++i) along[i] = main.dot(ground[i]), across[i] = side.dot(ground[i]);
-    lo = Eigen::Vector2d(detail::quantile(along, options.low_percentile),
-                         detail::quantile(across, options.low_percentile));
-    hi = Eigen::Vector2d(detail::quantile(along, options.high_percentile),
-                         detail::quantile(across, options.high_percentile));
+    detail::percentileRectangle(ground, main, options.low_percentile, options.high_percentile, &along, &across, &lo,
+                                &hi);
     for (size_t i = 0; i < ground.size(); ++i)
       inlier[i] = along[i] >= lo.x() && along[i] <= hi.x() && across[i] >= lo.y() && across[i] <= hi.y();
   }
@@ -175,13 +174,8 @@ inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vec
     const auto axis = detail::minAreaRectangleAxis(footprint);
     if (!axis) return std::nullopt;
     main = *axis;
-    const Eigen::Vector2d side(-main.y(), main.x());
-    std::vector<double> along(ground.size()), across(ground.size());
-    for (size_t i = 0; i < ground.size(); ++i) along[i] = main.dot(ground[i]), across[i] = side.dot(ground[i]);
-    lo = Eigen::Vector2d(detail::quantile(along, options.low_percentile),
-                         detail::quantile(across, options.low_percentile));
-    hi = Eigen::Vector2d(detail::quantile(along, options.high_percentile),
-                         detail::quantile(across, options.high_percentile));
+    detail::percentileRectangle(ground, main, options.low_percentile, options.high_percentile, &along, &across, &lo,
+                                &hi);
   }
   const double yaw = std::atan2(main.y(), main.x());
 
@@ -189,8 +183,8 @@ inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vec
   cuboid.rotation.col(0) = B.leftCols<2>() * main;
   cuboid.rotation.col(2) = B.col(2);
   cuboid.rotation.col(1) = cuboid.rotation.col(2).cross(cuboid.rotation.col(0));
-  const double h_lo = detail::quantile(heights, options.low_percentile);
-  const double h_hi = detail::quantile(heights, options.high_percentile);
+  const double h_lo = interpolatedQuantile(heights, options.low_percentile);
+  const double h_hi = interpolatedQuantile(heights, options.high_percentile);
   const Eigen::Vector3d local_lo(lo.x(), lo.y(), h_lo), local_hi(hi.x(), hi.y(), h_hi);
   // The second pass's percentiles are of all points in its final frame: outliers stay out.
   cuboid.half = 0.5 * (local_hi - local_lo) + Eigen::Vector3d::Constant(options.extent_padding);

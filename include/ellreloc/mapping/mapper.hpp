@@ -4,7 +4,7 @@
 ///
 /// Voxel mode (the paper, RGB-D): each detection's mask and the keyframe's depth update a
 /// voxel object (voxel_object.hpp); detections are tracked in 2D against the objects seen in
-/// the last keyframes and matched in 3D against the whole map (object_tracker.hpp); an object
+/// the last keyframes and matched in 3D against the whole map (association.hpp); an object
 /// enters the map after `min_observations` (omega0 = 3) observations, its label is its most
 /// frequent category, its low-probability voxels are pruned at every update, and its
 /// ellipsoid comes from the PCA yaw builder (ellipsoid_builder.hpp).
@@ -25,8 +25,8 @@
 #include "ellreloc/core/depth_image.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
 #include "ellreloc/mapping/ellipsoid_builder.hpp"
-#include "ellreloc/mapping/gravity.hpp"
-#include "ellreloc/mapping/object_tracker.hpp"
+#include "ellreloc/mapping/floor.hpp"
+#include "ellreloc/mapping/association.hpp"
 #include "ellreloc/mapping/voxel_object.hpp"
 
 namespace ellreloc {
@@ -121,6 +121,10 @@ class Mapper {
   void checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const;
   void addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage& depth,
                         KeyframeReport* report);
+  /// 2D association (association.hpp) of the used detections with tracks' expected boxes
+  /// (track index, box): each used detection's track index, or -1.
+  std::vector<int> associate2D(const std::vector<std::pair<size_t, Box>>& expected,
+                               const std::vector<Detection>& detections, const std::vector<size_t>& used) const;
   void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report);
   void observed(Track& track, const Detection& detection);
   void mergeDuplicateBoxTracks();

@@ -1,5 +1,5 @@
 #pragma once
-/// \file object_tracker.hpp
+/// \file association.hpp
 /// Object tracking of the paper ("Objects Tracking"): 2D association of map objects with a
 /// keyframe's detections, and 3D matching of the detections left over against the map.
 ///

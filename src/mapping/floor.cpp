@@ -1,4 +1,4 @@
-#include "ellreloc/mapping/gravity.hpp"
+#include "ellreloc/mapping/floor.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>

@@ -2,7 +2,7 @@
 
 #include <Eigen/Geometry>
 
-#include "ellreloc/mapping/gravity.hpp"
+#include "ellreloc/mapping/floor.hpp"
 #include "ellreloc/mapping/mapper.hpp"
 #include "mapping/sim_sequence.hpp"
 

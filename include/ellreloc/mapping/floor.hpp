@@ -1,5 +1,5 @@
 #pragma once
-/// \file gravity.hpp
+/// \file floor.hpp
 /// The up direction (against gravity) from a depth image: the dominant plane whose normal is
 /// within a few degrees of a prior (the floor, or table tops parallel to it), found by a seeded
 /// RANSAC over back-projected depth pixels and refined by least squares on its inliers. Used by

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Builds the benchmarks, runs them all, and rewrites the generated tables of docs/benchmarks.md
+# from this one run (each between <!-- bench:NAME --> and <!-- /bench:NAME -->, stamped with the
+# date, the core count and the command). Raw outputs stay in $ELLRELOC_BUILD_DIR/bench-results.
+#   scripts/benchmarks.sh           the full set (about 20 minutes on 2 cores)
+#   scripts/benchmarks.sh --quick   fewer repetitions and seeds, no exhaustive baseline on the cluttered scene
+set -euo pipefail
+cd "$(dirname "$0")/.."
+quick=0
+[ "${1:-}" = "--quick" ] && quick=1
+build="${ELLRELOC_BUILD_DIR:-build}"
+scripts/build.sh >/dev/null
+out="$build/bench-results"
+rm -rf "$out" && mkdir -p "$out"
+bin="$build/benchmarks"
+reps=5 seeds=5
+[ $quick = 1 ] && reps=3 seeds=2
+
+gbench() {  # NAME BINARY [FILTER]: Google Benchmark, medians of $reps repetitions, as JSON
+  local name=$1 binary=$2 filter=${3:-.}
+  local cmd="$bin/$binary --benchmark_filter=$filter --benchmark_repetitions=$reps --benchmark_report_aggregates_only=true"
+  echo "benchmarks: $name" >&2
+  $cmd --benchmark_format=json >"$out/$name.json" 2>/dev/null
+  echo "$cmd" >"$out/$name.command"
+}
+table() {  # NAME COMMAND...: an accuracy binary that prints a Markdown table
+  local name=$1
+  shift
+  echo "benchmarks: $name" >&2
+  "$@" >"$out/$name.txt"
+  echo "$*" >"$out/$name.command"
+}
+
+gbench core bench_core
+gbench p3p bench_p3p
+gbench refiner bench_pose 'Refine'
+gbench relocalize_room bench_pose 'Relocalize|WorstCase'
+gbench observe bench_observe
+gbench sim bench_sim
+gbench mapping bench_mapping
+if [ $quick = 1 ]; then
+  table reloc_accuracy "$bin/reloc_accuracy" --ours-only
+else
+  table reloc_accuracy "$bin/reloc_accuracy"
+fi
+table observe_accuracy "$bin/observe_accuracy"
+table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
+
+python3 scripts/benchmark_tables.py "$out" docs/benchmarks.md "$(nproc)"
+echo "benchmarks: docs/benchmarks.md rewritten from $out" >&2
