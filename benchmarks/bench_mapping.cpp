@@ -6,7 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include "ellreloc/mapping/mapper.hpp"
-#include "mapping/sim_sequence.hpp"
+#include "fixtures/sim_sequence.hpp"
 
 using namespace ellreloc;
 

@@ -10,7 +10,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "ellreloc/core/p3p.hpp"
-#include "pose/p3p_problems.hpp"
+#include "fixtures/p3p_problems.hpp"
 #ifdef ELLRELOC_HAVE_OPENGV
 #include <opengv/absolute_pose/CentralAbsoluteAdapter.hpp>
 #include <opengv/absolute_pose/methods.hpp>

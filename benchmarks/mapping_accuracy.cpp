@@ -18,7 +18,7 @@
 #include "ellreloc/io/trajectory.hpp"
 #include "ellreloc/mapping/hungarian.hpp"
 #include "ellreloc/mapping/mapper.hpp"
-#include "mapping/sim_sequence.hpp"
+#include "fixtures/sim_sequence.hpp"
 
 using namespace ellreloc;
 

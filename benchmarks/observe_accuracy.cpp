@@ -14,7 +14,7 @@
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
 #include "ellreloc/observe/observe.hpp"
-#include "observe/mask_shapes.hpp"
+#include "fixtures/mask_shapes.hpp"
 
 using namespace ellreloc;
 

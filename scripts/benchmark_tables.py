@@ -30,8 +30,14 @@ def gbench_table(path):
 
 
 def text_table(path):
-    lines = [l for l in path.read_text().splitlines() if l.startswith("|")]
-    return "\n".join(lines)
+    """The table lines of an output; separate tables stay separated by a blank line."""
+    out = []
+    for line in path.read_text().splitlines():
+        if line.startswith("|"):
+            out.append(line)
+        elif out and out[-1] != "":
+            out.append("")
+    return "\n".join(out).strip("\n")
 
 
 def main(results, doc, cores):

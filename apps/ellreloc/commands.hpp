@@ -51,6 +51,7 @@ struct RelocalizeArgs {
   bool use_points = false;  ///< refine with the frames' keypoints matched to the map's points
   std::string points;       ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;
+  double max_time_ms = 0.0;  ///< wall-clock budget of each frame's search; 0: none
   std::vector<double> camera_up, map_up;  ///< a gravity prior for every frame, when both are given
   double gravity_sigma_deg = 2.0;
 };

@@ -87,7 +87,8 @@ void writePlot(const std::string& path, const std::vector<io::StampedPose>& gt,
 
 RelocalizationSummary evaluate(const EvaluateArgs& a) {
   const std::vector<io::StampedPose> gt = io::readTumTrajectory(a.groundtruth);
-  const std::vector<io::StampedPose> est = io::readTumTrajectory(a.estimate);
+  // An estimate without poses is a run that relocalized nothing: 0% valid, not an error.
+  const std::vector<io::StampedPose> est = io::readTumTrajectory(a.estimate, /*allow_empty=*/true);
   // The query frames: those of the detections file when given, else every ground-truth pose.
   std::vector<double> queries;
   if (!a.detections.empty()) {
@@ -117,6 +118,10 @@ RelocalizationSummary evaluate(const EvaluateArgs& a) {
 void printEvaluation(const RelocalizationSummary& e) {
   std::printf("| median position error (cm) | median rotation error (deg) | valid %% | relocalized |\n");
   std::printf("| --- | --- | --- | --- |\n");
+  if (e.valid == 0) {  // no valid frame: no median error to show
+    std::printf("| - | - | %.1f | %d / %d |\n", e.validPercent(), e.relocalized, e.frames);
+    return;
+  }
   std::printf("| %.1f | %.2f | %.1f | %d / %d |\n", e.median_position_cm, e.median_rotation_deg, e.validPercent(),
               e.relocalized, e.frames);
 }

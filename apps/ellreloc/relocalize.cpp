@@ -4,7 +4,9 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -35,6 +37,11 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
                 "layout), or from the detections file when no file is given")
       ->expected(0, 1);
   r->add_option("--threads", a.threads, "frames in parallel")->capture_default_str()->check(CLI::Range(1, 256));
+  r->add_option("--max-time-ms", a.max_time_ms,
+                "wall-clock budget of each frame's hypothesis search in ms (0: none; results then depend on the "
+                "machine)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e9));
   auto* camera_up = r->add_option("--camera-up", a.camera_up,
                                   "gravity prior: the up direction in the camera frame (x right, y down, z forward), "
                                   "for a camera at a fixed tilt, e.g. 0,-1,0 for a level camera")
@@ -66,6 +73,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   } else if (a.method != "ours") {
     throw Error("--method: unknown method '" + a.method + "' (ours, oa-slam)");
   }
+  options.search.budget.max_time_ms = a.max_time_ms;
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "paper" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
@@ -87,32 +95,44 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
       keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
   }
 
-  // Frames are independent: workers take the next frame until none is left.
+  // Frames are independent: `threads` workers take the next frame until none is left (the
+  // calling thread only shows progress). The first exception of any worker stops the others
+  // and is rethrown here, so a worker's failure is reported like the calling thread's.
   std::vector<RelocalizationResult> results(frames.size());
   std::vector<int> observed(frames.size(), 0);
   std::atomic<size_t> next(0), finished(0);
+  std::atomic<bool> failed(false);
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
   const auto work = [&] {
-    for (size_t i = next++; i < frames.size(); i = next++) {
-      std::vector<Observation> observations;
-      for (const Detection& d : frames[i].detections)
-        if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
-          observations.push_back(*r.observation);
-      observed[i] = static_cast<int>(observations.size());
-      results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
-      ++finished;
+    try {
+      for (size_t i = next++; i < frames.size() && !failed; i = next++) {
+        std::vector<Observation> observations;
+        for (const Detection& d : frames[i].detections)
+          if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
+            observations.push_back(*r.observation);
+        observed[i] = static_cast<int>(observations.size());
+        results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
+        ++finished;
+      }
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      failed = true;
     }
   };
   std::vector<std::thread> workers;
-  for (int t = 1; t < a.threads; ++t) workers.emplace_back(work);
   if (a.threads <= 1) {
     work();
   } else {
-    while (finished < frames.size()) {
+    for (int t = 0; t < a.threads; ++t) workers.emplace_back(work);
+    while (finished < frames.size() && !failed) {
       console.progress("relocalize", finished, frames.size());
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
   for (std::thread& w : workers) w.join();
+  if (failure) std::rethrow_exception(failure);
   console.endProgress();
 
   std::vector<io::StampedPose> poses;

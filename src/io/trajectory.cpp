@@ -10,7 +10,7 @@
 
 namespace ellreloc::io {
 
-std::vector<StampedPose> readTumTrajectory(const std::string& path) {
+std::vector<StampedPose> readTumTrajectory(const std::string& path, bool allow_empty) {
   std::vector<StampedPose> poses;
   forEachDataLine(readTextFile(path), [&](int line_no, const std::string& line) {
     const std::string where = path + ": line " + std::to_string(line_no) + ": ";
@@ -27,7 +27,7 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path) {
     q.normalize();
     poses.push_back({v[0], Pose::fromCameraToWorld(q.toRotationMatrix(), Eigen::Vector3d(v[1], v[2], v[3]))});
   });
-  if (poses.empty()) throw Error(path + ": no poses found (empty trajectory)");
+  if (poses.empty() && !allow_empty) throw Error(path + ": no poses found (empty trajectory)");
   return poses;
 }
 

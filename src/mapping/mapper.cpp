@@ -16,7 +16,6 @@ bool boxFinite(const Box& b) {
   return std::isfinite(b.x1) && std::isfinite(b.y1) && std::isfinite(b.x2) && std::isfinite(b.y2);
 }
 
-
 }  // namespace
 
 const char* toString(MappingMode mode) { return mode == MappingMode::Voxel ? "voxel" : "boxes"; }
@@ -42,8 +41,7 @@ Mapper::Mapper(const Intrinsics& K, const MapperOptions& options) : K_(K), optio
     throw Error("mapper: voxel size must be positive and min_observations, track_window, candidate_lifetime >= 1");
 }
 
-void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detections,
-                           const DepthImage* depth) const {
+void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const {
   const std::string where = keyframeText(keyframes_);
   if (!pose.isValid()) throw Error(where + ": pose is not a finite rigid transform");
   if (options_.mode == MappingMode::Voxel) {

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "io/temp_dir.hpp"
+#include "fixtures/temp_dir.hpp"
 
 namespace {
 
@@ -39,6 +39,13 @@ int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), 
 std::string data(const std::string& name) { return std::string(ELLRELOC_TEST_DATA_DIR) + "/" + name; }
 
 void writeFile(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
 
 TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
   ellreloc::test::TempDir dir;
@@ -80,6 +87,21 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
     EXPECT_NE(r.out.find("valid %"), std::string::npos);
     EXPECT_GT(fs::file_size(dir.path(method + ".png")), 1000u);
   }
+  // One thread, two threads and a time budget that is never reached give the same poses.
+  for (const std::string extra : {"--threads 1", "--threads 2 --max-time-ms 100000"}) {
+    r = run("relocalize --camera " + s + "/camera.yaml --map " + dir.path("map_voxel.json") + " --detections " + s +
+                "/query/detections.json " + extra + " --out " + dir.path("again.txt"),
+            dir);
+    ASSERT_EQ(r.code, 0) << extra << ": " << r.err;
+    EXPECT_EQ(readFile(dir.path("again.txt")), readFile(dir.path("ours.txt"))) << extra;
+  }
+  // A run that relocalized nothing evaluates to 0% valid, without median errors.
+  writeFile(dir.path("nothing.txt"), "# timestamp tx ty tz qx qy qz qw (camera->world)\n");
+  r = run("evaluate --groundtruth " + s + "/query/groundtruth.txt --estimate " + dir.path("nothing.txt") +
+              " --detections " + s + "/query/detections.json",
+          dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("| - | - | 0.0 | 0 / "), std::string::npos) << r.out;
   // Keypoints matched to the map's points, from the detections file itself.
   r = run("relocalize --camera " + s + "/camera.yaml --map " + s + "/map_perturbed.json --detections " + s +
               "/query/detections.json --points --out " + dir.path("points.txt"),

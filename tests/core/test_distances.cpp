@@ -1,6 +1,6 @@
 #include "ellreloc/core/distances.hpp"
 
-#include "../random_geometry.hpp"
+#include "fixtures/random_geometry.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>

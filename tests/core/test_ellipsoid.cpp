@@ -1,6 +1,6 @@
 #include "ellreloc/core/ellipsoid.hpp"
 
-#include "../random_geometry.hpp"
+#include "fixtures/random_geometry.hpp"
 
 #include <gtest/gtest.h>
 

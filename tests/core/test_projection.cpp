@@ -1,6 +1,6 @@
 #include "ellreloc/core/projection.hpp"
 
-#include "../random_geometry.hpp"
+#include "fixtures/random_geometry.hpp"
 
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>

@@ -15,7 +15,7 @@
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
-#include "temp_dir.hpp"
+#include "fixtures/temp_dir.hpp"
 
 namespace ellreloc {
 namespace {

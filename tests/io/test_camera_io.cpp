@@ -1,10 +1,10 @@
 #include <gtest/gtest.h>
 
-#include "../data_dir.hpp"
+#include "fixtures/data_dir.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/files.hpp"
-#include "temp_dir.hpp"
+#include "fixtures/temp_dir.hpp"
 
 using namespace ellreloc;
 

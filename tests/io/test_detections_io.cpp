@@ -6,8 +6,8 @@
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/io/trajectory.hpp"
 
-#include "../data_dir.hpp"
-#include "temp_dir.hpp"
+#include "fixtures/data_dir.hpp"
+#include "fixtures/temp_dir.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -3,11 +3,11 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
-#include "../data_dir.hpp"
+#include "fixtures/data_dir.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 #include "ellreloc/io/rgbd.hpp"
-#include "temp_dir.hpp"
+#include "fixtures/temp_dir.hpp"
 
 using namespace ellreloc;
 

@@ -2,9 +2,9 @@
 #include "ellreloc/io/files.hpp"
 #include "ellreloc/io/trajectory.hpp"
 
-#include "../data_dir.hpp"
-#include "../random_geometry.hpp"
-#include "temp_dir.hpp"
+#include "fixtures/data_dir.hpp"
+#include "fixtures/random_geometry.hpp"
+#include "fixtures/temp_dir.hpp"
 
 #include <gtest/gtest.h>
 

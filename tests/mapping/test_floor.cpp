@@ -4,7 +4,7 @@
 
 #include "ellreloc/mapping/floor.hpp"
 #include "ellreloc/mapping/mapper.hpp"
-#include "mapping/sim_sequence.hpp"
+#include "fixtures/sim_sequence.hpp"
 
 namespace ellreloc {
 namespace {

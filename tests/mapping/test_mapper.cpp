@@ -7,8 +7,8 @@
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/mapping/mapper.hpp"
-#include "io/temp_dir.hpp"
-#include "mapping/sim_sequence.hpp"
+#include "fixtures/temp_dir.hpp"
+#include "fixtures/sim_sequence.hpp"
 
 namespace ellreloc {
 namespace {

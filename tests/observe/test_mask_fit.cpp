@@ -2,15 +2,15 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "../data_dir.hpp"
-#include "../random_geometry.hpp"
+#include "fixtures/data_dir.hpp"
+#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
 #include "ellreloc/core/mask.hpp"
-#include "mask_outline.hpp"
-#include "mask_shapes.hpp"
+#include "fixtures/mask_outline.hpp"
+#include "fixtures/mask_shapes.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;

@@ -2,13 +2,13 @@
 
 #include <map>
 
-#include "../data_dir.hpp"
-#include "../random_geometry.hpp"
+#include "fixtures/data_dir.hpp"
+#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/observe/regular_mask.hpp"
-#include "mask_shapes.hpp"
+#include "fixtures/mask_shapes.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "../random_geometry.hpp"
+#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/few_object_poses.hpp"
 

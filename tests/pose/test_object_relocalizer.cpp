@@ -2,7 +2,7 @@
 
 #include <thread>
 
-#include "../random_geometry.hpp"
+#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/sim/map_observations.hpp"

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "ellreloc/core/p3p.hpp"
-#include "p3p_problems.hpp"
+#include "fixtures/p3p_problems.hpp"
 
 using namespace ellreloc;
 

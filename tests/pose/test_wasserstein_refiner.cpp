@@ -2,7 +2,7 @@
 #include <ceres/loss_function.h>
 #include <gtest/gtest.h>
 
-#include "../random_geometry.hpp"
+#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"

@@ -2,7 +2,7 @@
 
 #include <filesystem>
 
-#include "../io/temp_dir.hpp"
+#include "fixtures/temp_dir.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/files.hpp"

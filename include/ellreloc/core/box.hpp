@@ -4,7 +4,6 @@
 /// centre of the top-left pixel).
 
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <cmath>
 
@@ -23,8 +22,7 @@ struct Box {
   Eigen::Vector2d center() const { return {0.5 * (x1 + x2), 0.5 * (y1 + y2)}; }
 
   bool isValid() const {
-    return std::isfinite(x1) && std::isfinite(y1) && std::isfinite(x2) && std::isfinite(y2) &&
-           x1 <= x2 && y1 <= y2;
+    return std::isfinite(x1) && std::isfinite(y1) && std::isfinite(x2) && std::isfinite(y2) && x1 <= x2 && y1 <= y2;
   }
 
   /// The overlap of two boxes; an empty box (zero width or height) when they are disjoint.

@@ -4,13 +4,12 @@
 /// docs/distances.md. Invalid ellipses (see Ellipse::isValid) give +infinity for distances and
 /// 0 for overlaps, never NaN.
 
-#include "ellreloc/core/ellipse.hpp"
-
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "ellreloc/core/ellipse.hpp"
 
 namespace ellreloc {
 

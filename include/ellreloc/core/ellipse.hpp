@@ -7,13 +7,12 @@
 /// R(angle) diag(a^2, b^2) R(angle)^T. The dual conic is C* = H diag(a^2, b^2, -1) H^T with
 /// H = [R c; 0 1], i.e. normalised so that C*(2,2) = -1.
 
-#include "ellreloc/core/box.hpp"
-
 #include <Eigen/Core>
-
 #include <cmath>
 #include <optional>
 #include <vector>
+
+#include "ellreloc/core/box.hpp"
 
 namespace ellreloc {
 
@@ -101,8 +100,8 @@ class Ellipse {
 
   /// Finite parameters and strictly positive semi-axes.
   bool isValid() const {
-    return center_.allFinite() && std::isfinite(angle_) && std::isfinite(axes_(0)) &&
-           std::isfinite(axes_(1)) && axes_(0) > 0.0 && axes_(1) > 0.0;
+    return center_.allFinite() && std::isfinite(angle_) && std::isfinite(axes_(0)) && std::isfinite(axes_(1)) &&
+           axes_(0) > 0.0 && axes_(1) > 0.0;
   }
 
   Eigen::Matrix2d rotation() const {

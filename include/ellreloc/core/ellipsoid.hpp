@@ -7,7 +7,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
-
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -65,9 +64,7 @@ class Ellipsoid {
   }
 
   /// Shape matrix R diag(a^2, b^2, c^2) R^T: the ellipsoid is (x-c)^T M^-1 (x-c) <= 1.
-  Eigen::Matrix3d shapeMatrix() const {
-    return rotation_ * axes_.cwiseAbs2().asDiagonal() * rotation_.transpose();
-  }
+  Eigen::Matrix3d shapeMatrix() const { return rotation_ * axes_.cwiseAbs2().asDiagonal() * rotation_.transpose(); }
 
   /// Dual quadric, normalised so that Q*(3,3) = -1.
   Eigen::Matrix4d dualQuadric() const {

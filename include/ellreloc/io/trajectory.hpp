@@ -3,11 +3,11 @@
 /// TUM trajectories (`timestamp tx ty tz qx qy qz qw`, camera->world on disk; world->camera
 /// Pose in memory) and TUM association files.
 
-#include "ellreloc/core/camera.hpp"
-
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "ellreloc/core/camera.hpp"
 
 namespace ellreloc::io {
 
@@ -17,8 +17,9 @@ struct StampedPose {
 };
 
 /// Reads a TUM trajectory; `#` starts a comment. Quaternions are normalised; a zero or
-/// non-finite one is an error naming the line. Throws ellreloc::Error on malformed input.
-std::vector<StampedPose> readTumTrajectory(const std::string& path);
+/// non-finite one is an error naming the line. Throws ellreloc::Error on malformed input, and
+/// on a file without poses unless `allow_empty` (a run that relocalized no frame writes one).
+std::vector<StampedPose> readTumTrajectory(const std::string& path, bool allow_empty = false);
 
 /// Writes camera->world lines with full precision, atomically.
 void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses);

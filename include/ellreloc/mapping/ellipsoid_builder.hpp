@@ -67,8 +67,8 @@ struct BuiltEllipsoid {
 namespace detail {
 /// The percentile rectangle of ground-plane points along `main` and across it (lo, hi in
 /// (along, across) coordinates); `along` and `across` receive every point's coordinates.
-inline void percentileRectangle(const std::vector<Eigen::Vector2d>& ground, const Eigen::Vector2d& main,
-                                double low, double high, std::vector<double>* along, std::vector<double>* across,
+inline void percentileRectangle(const std::vector<Eigen::Vector2d>& ground, const Eigen::Vector2d& main, double low,
+                                double high, std::vector<double>* along, std::vector<double>* across,
                                 Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
   const Eigen::Vector2d side(-main.y(), main.x());
   along->resize(ground.size());

@@ -20,13 +20,13 @@
 #include <vector>
 
 #include "ellreloc/core/camera.hpp"
-#include "ellreloc/core/object_map.hpp"
-#include "ellreloc/core/detection.hpp"
 #include "ellreloc/core/depth_image.hpp"
+#include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/object_map.hpp"
+#include "ellreloc/mapping/association.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
 #include "ellreloc/mapping/ellipsoid_builder.hpp"
 #include "ellreloc/mapping/floor.hpp"
-#include "ellreloc/mapping/association.hpp"
 #include "ellreloc/mapping/voxel_object.hpp"
 
 namespace ellreloc {
@@ -57,7 +57,7 @@ struct MapperOptions {
   /// ellipsoid.up, which is then only the prior. Objects are rebuilt with it when next updated.
   bool estimate_up_from_floor = false;
   FloorOptions floor;
-  long min_mask_pixels = 30;    ///< smaller masks are ignored
+  long min_mask_pixels = 30;  ///< smaller masks are ignored
 };
 
 /// What one keyframe did.
