@@ -61,6 +61,60 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
   return r;
 }
 
+namespace {
+
+/// Observes and relocalizes every frame on `threads` worker threads; `observed` receives each
+/// frame's number of observations.
+std::vector<RelocalizationResult> relocalizeFrames(const ObjectRelocalizer& relocalizer,
+                                                   const std::vector<DetectionFrame>& frames,
+                                                   const std::vector<std::vector<Keypoint>>& keypoints,
+                                                   const std::optional<GravityPrior>& gravity,
+                                                   const ObserveOptions& observe_options, int threads,
+                                                   const Console& console, std::vector<int>* observed_out) {
+  // Frames are independent: `threads` workers take the next frame until none is left (the
+  // calling thread only shows progress). The first exception of any worker stops the others
+  // and is rethrown here, so a worker's failure is reported like the calling thread's.
+  std::vector<RelocalizationResult> results(frames.size());
+  std::vector<int>& observed = *observed_out;
+  const Intrinsics& K = relocalizer.intrinsics();
+  std::atomic<size_t> next(0), finished(0);
+  std::atomic<bool> failed(false);
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto work = [&] {
+    try {
+      for (size_t i = next++; i < frames.size() && !failed; i = next++) {
+        std::vector<Observation> observations;
+        for (const Detection& d : frames[i].detections)
+          if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
+            observations.push_back(*r.observation);
+        observed[i] = static_cast<int>(observations.size());
+        results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
+        ++finished;
+      }
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      failed = true;
+    }
+  };
+  std::vector<std::thread> workers;
+  if (threads <= 1) {
+    work();
+  } else {
+    for (int t = 0; t < threads; ++t) workers.emplace_back(work);
+    while (finished < frames.size() && !failed) {
+      console.progress("relocalize", finished, frames.size());
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  for (std::thread& w : workers) w.join();
+  if (failure) std::rethrow_exception(failure);
+  return results;
+}
+
+}  // namespace
+
 int relocalize(const RelocalizeArgs& a, const Console& console) {
   const Intrinsics K = io::readCamera(a.camera);
   const ObjectMap object_map = io::readMap(a.map);
@@ -95,44 +149,9 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
       keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
   }
 
-  // Frames are independent: `threads` workers take the next frame until none is left (the
-  // calling thread only shows progress). The first exception of any worker stops the others
-  // and is rethrown here, so a worker's failure is reported like the calling thread's.
-  std::vector<RelocalizationResult> results(frames.size());
   std::vector<int> observed(frames.size(), 0);
-  std::atomic<size_t> next(0), finished(0);
-  std::atomic<bool> failed(false);
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  const auto work = [&] {
-    try {
-      for (size_t i = next++; i < frames.size() && !failed; i = next++) {
-        std::vector<Observation> observations;
-        for (const Detection& d : frames[i].detections)
-          if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
-            observations.push_back(*r.observation);
-        observed[i] = static_cast<int>(observations.size());
-        results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
-        ++finished;
-      }
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      failed = true;
-    }
-  };
-  std::vector<std::thread> workers;
-  if (a.threads <= 1) {
-    work();
-  } else {
-    for (int t = 0; t < a.threads; ++t) workers.emplace_back(work);
-    while (finished < frames.size() && !failed) {
-      console.progress("relocalize", finished, frames.size());
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-  for (std::thread& w : workers) w.join();
-  if (failure) std::rethrow_exception(failure);
+  const std::vector<RelocalizationResult> results =
+      relocalizeFrames(relocalizer, frames, keypoints, gravity, observe_options, a.threads, console, &observed);
   console.endProgress();
 
   std::vector<io::StampedPose> poses;
