@@ -56,17 +56,13 @@ struct Problem {
       const Projection p = project(objects[i]->ellipsoid, K, pose);
       if (!p) return false;
       const double s = wasserstein2Squared(objects[i]->observed, p.ellipse) / (object_scale[i] * object_scale[i]);
-      double drho = 0.0;
-      const double rho = robustLoss(opt.object_loss, opt.object_loss_scale, s, &drho);
-      sum += rho;
+      sum += robustLoss(opt.object_loss, opt.object_loss_scale, s);
     }
     for (const PointMatch& m : points) {
       const Eigen::Vector3d x = pose.transform(m.point);
       if (!(x(2) > 0.0)) return false;
       const double s = (K.project(x) - m.observed).squaredNorm() / (opt.point_sigma_px * opt.point_sigma_px);
-      double drho = 0.0;
-      const double rho = robustLoss(opt.point_loss, opt.point_loss_scale, s, &drho);
-      sum += opt.point_weight * rho;
+      sum += opt.point_weight * robustLoss(opt.point_loss, opt.point_loss_scale, s);
     }
     if (gravity) sum += gravityResidual(pose).squaredNorm();
     *total = sum;

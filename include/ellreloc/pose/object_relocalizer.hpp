@@ -34,7 +34,7 @@ namespace ellreloc {
 enum class RelocalizationStatus {
   Success,
   NotEnoughObservations,   ///< too few usable observations with a candidate object (see RelocalizerOptions)
-  NoConsistentHypothesis,  ///< no pose explains at least min_inliers observations
+  NoConsistentHypothesis,  ///< no pose explains at least scoring.min_inliers observations
   InvalidInput,            ///< invalid intrinsics, gravity prior or options
 };
 
@@ -88,7 +88,7 @@ class ObjectRelocalizer {
 
   /// Scores a pose from elsewhere (tracking, odometry, another relocalizer) the way
   /// relocalize() scores its hypotheses: one-to-one matches, their overlaps and the truncated
-  /// cost, with Success when it explains min_inliers observations (fewer if fewer are usable).
+  /// cost, with Success when it explains scoring.min_inliers observations (fewer if fewer are usable).
   RelocalizationResult scorePose(const std::vector<Observation>& observations, const Pose& pose) const;
 
   const ObjectMap& map() const { return map_; }
