@@ -2,10 +2,10 @@
 
 #include <thread>
 
-#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/sim/map_observations.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::positionError;
@@ -88,6 +88,35 @@ TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
   }
   EXPECT_GE(tried, 4);
   EXPECT_GE(recovered, tried - 1);
+}
+
+// Options out of range are refused with the field's name, before any work (a NaN cost used to
+// give Success with a NaN score).
+TEST(ObjectRelocalizer, InvalidOptionsGiveInvalidInputNamingTheField) {
+  std::mt19937 rng(84);
+  const Intrinsics K = test::testIntrinsics();
+  const Synthetic s = makeSceneSeeing(rng, 5, 12, 6);
+  EXPECT_TRUE(RelocalizerOptions().validate().empty());
+  EXPECT_TRUE(RelocalizerOptions::oaSlam().validate().empty());
+  const auto expectRefused = [&](const RelocalizerOptions& o, const std::string& field) {
+    const RelocalizationResult r = ObjectRelocalizer(s.map, K, o).relocalize(s.observations);
+    EXPECT_EQ(r.status, RelocalizationStatus::InvalidInput) << field;
+    EXPECT_NE(r.reason.find(field), std::string::npos) << r.reason;
+    EXPECT_EQ(ObjectRelocalizer(s.map, K, o).scorePose(s.observations, s.truth).status,
+              RelocalizationStatus::InvalidInput);
+  };
+  RelocalizerOptions o;
+  o.scoring.unmatched_cost = std::nan("");
+  expectRefused(o, "scoring.unmatched_cost");
+  o = RelocalizerOptions();
+  o.scoring.min_overlap = 1.5;
+  expectRefused(o, "scoring.min_overlap");
+  o = RelocalizerOptions();
+  o.search.budget.max_time_ms = -1.0;
+  expectRefused(o, "search.budget.max_time_ms");
+  o = RelocalizerOptions();
+  o.refinement.top_k = 0;
+  expectRefused(o, "refinement.top_k");
 }
 
 TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
