@@ -19,7 +19,8 @@ EllipseMatch ellipseMatchOf(const CandidatePair& pair, const std::vector<Observa
 
 }  // namespace
 
-bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int count, KnownProjections* own) const {
+bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int count, bool check_overlap,
+                                 KnownProjections* own) const {
   if (!gate_.admits(pose)) return false;
   own->count = 0;
   for (int k = 0; k < count; ++k) {
@@ -30,6 +31,10 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
     own->ellipses[k] = p.ellipse;
     own->count = k + 1;
   }
+  for (int k = 0; k < count && check_overlap; ++k)
+    if (scorer_.overlap(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k], kRankingIoUVertices) <
+        options_.scoring.min_overlap)
+      return false;
   return true;
 }
 
@@ -50,12 +55,7 @@ int HypothesisEstimator::generate(const int* s, Model* models) const {
   for (int i = 0; i < n; ++i) {
     Model m{poses[i], {}};
     if (options_.search.correct_centres && !correctCentres(s, &m.pose)) continue;
-    if (!accept(m.pose, s, 3, &m.own)) continue;
-    bool overlapping = true;
-    for (int k = 0; k < 3 && overlapping && options_.search.check_sample_overlap; ++k)
-      overlapping = scorer_.overlap(observations_[pairs_[s[k]].observation], m.own.ellipses[k], kRankingIoUVertices) >=
-                    options_.scoring.min_overlap;
-    if (overlapping) models[count++] = m;
+    if (accept(m.pose, s, 3, options_.search.check_sample_overlap, &m.own)) models[count++] = m;
   }
   return count;
 }
@@ -94,12 +94,8 @@ void HypothesisEstimator::fromSolver(const std::vector<ScoredPose>& poses, const
                                      std::vector<Model>* out) const {
   for (const ScoredPose& p : poses) {
     Model m{p.pose, {}};
-    if (!accept(m.pose, pair_indices, count, &m.own)) continue;
-    bool overlapping = true;  // the pairs the pose came from must match at it
-    for (int k = 0; k < count && overlapping; ++k)
-      overlapping = scorer_.overlap(observations_[pairs_[pair_indices[k]].observation], m.own.ellipses[k],
-                                    kRankingIoUVertices) >= options_.scoring.min_overlap;
-    if (overlapping) out->push_back(m);
+    // The pairs the pose came from must match at it.
+    if (accept(m.pose, pair_indices, count, /*check_overlap=*/true, &m.own)) out->push_back(m);
   }
 }
 

@@ -60,8 +60,9 @@ class HypothesisEstimator {
   void fromOnePair(int a, const GravityPrior& gravity, std::vector<Model>* out) const;
 
  private:
-  /// The gate, then every own pair in view and overlapping its observation; fills `own`.
-  bool accept(const Pose& pose, const int* pair_indices, int count, KnownProjections* own) const;
+  /// The gate, then every own pair in view and, with `check_overlap`, overlapping its
+  /// observation by scoring.min_overlap; fills `own`.
+  bool accept(const Pose& pose, const int* pair_indices, int count, bool check_overlap, KnownProjections* own) const;
   bool correctCentres(const int* pair_indices, Pose* pose) const;
   void fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,
                   std::vector<Model>* out) const;
