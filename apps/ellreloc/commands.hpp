@@ -42,6 +42,9 @@ ObservationPolicy parsePolicy(const std::string& name);
 
 struct MapArgs {
   std::string camera, associations, trajectory, detections, mode = "voxel", out;
+  int holdout_every = 0;   ///< every N-th frame is left out of the map and measures its quality
+  std::string holdout;     ///< detections of frames left out of the map, to measure its quality
+  std::vector<double> up;  ///< the world's up direction, when known
 };
 CLI::App* addMapCommand(CLI::App& app, MapArgs& a);
 void map(const MapArgs& a, const Console& console);
@@ -51,7 +54,7 @@ struct RelocalizeArgs {
   bool use_points = false;  ///< refine with the frames' keypoints matched to the map's points
   std::string points;       ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;
-  double max_time_ms = 0.0;  ///< wall-clock budget of each frame's search; 0: none
+  double max_time_ms = 0.0;               ///< wall-clock budget of each frame's search; 0: none
   std::vector<double> camera_up, map_up;  ///< a gravity prior for every frame, when both are given
   double gravity_sigma_deg = 2.0;
 };

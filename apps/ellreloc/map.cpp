@@ -12,6 +12,7 @@
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
+#include "ellreloc/mapping/map_quality.hpp"
 #include "ellreloc/mapping/mapper.hpp"
 
 namespace fs = std::filesystem;
@@ -21,6 +22,26 @@ namespace ellreloc::cli {
 namespace {
 
 std::string absoluteNormal(const fs::path& p) { return fs::absolute(p).lexically_normal().string(); }
+
+/// The frames that have a pose in the trajectory, with that pose.
+std::vector<PosedDetections> posedFrames(const std::vector<DetectionFrame>& frames,
+                                         const std::vector<io::StampedPose>& trajectory) {
+  std::vector<PosedDetections> out;
+  for (const DetectionFrame& f : frames) {
+    const std::optional<double> t = f.timestamp();
+    const std::optional<size_t> k = t ? io::findNearest(trajectory, *t) : std::nullopt;
+    if (k) out.push_back({trajectory[*k].pose, f.detections});
+  }
+  return out;
+}
+
+/// Printed even when quiet: it is a result.
+void printQuality(const MapQuality& q) {
+  std::printf(
+      "map quality on %zu held-out frames: median best same-category IoU %.3f (mean %.3f) over %zu boxes, "
+      "%zu overlap an object of their category\n",
+      q.frames, q.median_best_iou, q.mean_best_iou, q.boxes, q.explained);
+}
 
 }  // namespace
 
@@ -37,6 +58,18 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
       ->check(CLI::ExistingFile);
   m->add_option("--mode", a.mode, "voxel (RGB-D + masks) or boxes (boxes and poses only)")->capture_default_str();
   m->add_option("--out", a.out, "output map JSON")->required();
+  m->add_option("--up", a.up,
+                "the world's up direction (against gravity), e.g. 0,0,1: box-mode ellipsoids stand upright (yaw "
+                "only); voxel mode takes it as the ellipsoids' up")
+      ->expected(3)
+      ->delimiter(',');
+  m->add_option("--holdout-every", a.holdout_every,
+                "leave every N-th frame out of the map and report how well the map explains its boxes")
+      ->check(CLI::Range(2, 1000000));
+  m->add_option("--holdout", a.holdout,
+                "detections of frames not used for mapping (poses from --trajectory): report how well the map "
+                "explains their boxes")
+      ->check(CLI::ExistingFile);
   m->footer(
       "Example: ellreloc map --camera S/camera.yaml --associations S/mapping/associations.txt --trajectory "
       "S/mapping/trajectory.txt --detections S/mapping/detections.json --mode voxel --out map.json");
@@ -47,6 +80,12 @@ void map(const MapArgs& a, const Console& console) {
   const Intrinsics K = io::readCamera(a.camera);
   MapperOptions options;
   if (!parseMappingMode(a.mode, &options.mode)) throw Error("--mode: unknown mode '" + a.mode + "' (voxel, boxes)");
+  if (!a.up.empty()) {
+    const Eigen::Vector3d up(a.up[0], a.up[1], a.up[2]);
+    if (!up.allFinite() || !(up.norm() > 1e-9)) throw Error("--up: not a direction (finite, non-zero)");
+    options.ellipsoid.up = up.normalized();
+    options.boxes.up = up.normalized();
+  }
   const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   std::vector<io::Association> associations;
@@ -57,9 +96,16 @@ void map(const MapArgs& a, const Console& console) {
   const fs::path detections_dir = fs::path(a.detections).parent_path();
 
   Mapper mapper(K, options);
+  std::vector<PosedDetections> held_out;
+  if (!a.holdout.empty()) held_out = posedFrames(io::readDetections(a.holdout), trajectory);
   int used = 0, no_pose = 0, no_depth = 0;
   for (size_t i = 0; i < frames.size(); ++i) {
     const DetectionFrame& f = frames[i];
+    if (a.holdout_every > 0 && i % static_cast<size_t>(a.holdout_every) == static_cast<size_t>(a.holdout_every) - 1) {
+      std::vector<PosedDetections> one = posedFrames({f}, trajectory);
+      held_out.insert(held_out.end(), one.begin(), one.end());
+      continue;
+    }
     // The frame's depth: the association naming the same colour image, else the same time.
     const std::string rgb = absoluteNormal(detections_dir / f.file_name);
     const io::Association* assoc = nullptr;
@@ -92,11 +138,13 @@ void map(const MapArgs& a, const Console& console) {
   }
   console.endProgress();
   if (used == 0) throw Error(a.detections + ": no frame has both a pose in " + a.trajectory + " and its depth");
+  mapper.finish();
   const ObjectMap result = mapper.map();
   io::writeMap(a.out, result);
   if (!console.quiet)
     std::printf("wrote %s: %zu objects from %d keyframes (%s mode; %d frames without pose, %d without depth)\n",
                 a.out.c_str(), result.objects.size(), used, a.mode.c_str(), no_pose, no_depth);
+  if (!a.holdout.empty() || a.holdout_every > 0) printQuality(measureMapQuality(result, K, held_out));
 }
 
 }  // namespace ellreloc::cli

@@ -10,24 +10,27 @@
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/core/statistics.hpp"
+#include "ellreloc/mapping/ellipsoid_builder.hpp"
 
 namespace ellreloc {
 namespace {
 
 /// W2 between the box-inscribed ellipse and the projection of the ellipsoid (centre c,
-/// semi-axes exp(s), rotation angle-axis w), divided by sqrt(a b) of the observed ellipse so
-/// that small and large boxes weigh alike. The 6-vector r has |r|^2 = W2^2 (distances.hpp).
+/// semi-axes exp(s), rotation base * angle-axis w), divided by sqrt(a b) of the observed
+/// ellipse so that small and large boxes weigh alike. The 6-vector r has |r|^2 = W2^2
+/// (distances.hpp).
 struct BoxW2Cost {
   Eigen::Matrix<double, 3, 4> P;  // K [R | t]
   Pose pose;
   Ellipse observed;
   double scale;
+  Eigen::Matrix3d base;
 
   template <typename T>
   bool operator()(const T* c, const T* s, const T* w, T* residual) const {
     T R_data[9];
     ceres::AngleAxisToRotationMatrix(w, ceres::ColumnMajorAdapter3x3(R_data));
-    const Eigen::Map<const Eigen::Matrix<T, 3, 3>> R(R_data);
+    const Eigen::Matrix<T, 3, 3> R = base.cast<T>() * Eigen::Map<const Eigen::Matrix<T, 3, 3>>(R_data);
     const Eigen::Matrix<T, 3, 1> centre(c[0], c[1], c[2]);
     Eigen::Matrix<T, 3, 1> axes2;
     for (int k = 0; k < 3; ++k) axes2(k) = exp(T(2.0) * s[k]);
@@ -50,7 +53,30 @@ struct BoxW2Cost {
   }
 };
 
+/// The size prior (BoxSizePrior): the sorted log semi-axes against the sorted typical ones.
+struct SizePriorCost {
+  Eigen::Vector3d log_typical;  // sorted ascending
+  double sigma;
 
+  template <typename T>
+  bool operator()(const T* s, T* residual) const {
+    T v[3] = {s[0], s[1], s[2]};
+    // Sort three values ascending (compare-swap; Jets compare by their value).
+    if (v[1] < v[0]) std::swap(v[0], v[1]);
+    if (v[2] < v[1]) std::swap(v[1], v[2]);
+    if (v[1] < v[0]) std::swap(v[0], v[1]);
+    for (int k = 0; k < 3; ++k) residual[k] = (v[k] - T(log_typical(k))) / T(sigma);
+    return true;
+  }
+};
+
+/// At most `n` views, evenly spread over the sequence (all of them when there are fewer).
+std::vector<BoxView> spread(const std::vector<BoxView>& views, size_t n) {
+  if (views.size() <= n || n == 0) return views;
+  std::vector<BoxView> out;
+  for (size_t k = 0; k < n; ++k) out.push_back(views[k * (views.size() - 1) / (n - 1)]);
+  return out;
+}
 
 }  // namespace
 
@@ -93,7 +119,7 @@ std::optional<Eigen::Vector3d> triangulateBoxCentres(const Intrinsics& K, const 
 }
 
 BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vector<BoxView>& all_views,
-                                           const BoxEllipsoidOptions& options) {
+                                           const BoxEllipsoidOptions& options, const BoxSizePrior& prior) {
   BoxEllipsoidResult out;
   if (!K.isValid()) {
     out.reason = "invalid intrinsics";
@@ -105,7 +131,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
     valid.push_back(v);
     if (!v.box.nearImageBorder(K.width, K.height, options.border_px)) inside.push_back(v);
   }
-  const std::vector<BoxView>& views = inside.size() >= options.min_views ? inside : valid;
+  const std::vector<BoxView> views = spread(inside.size() >= options.min_views ? inside : valid, options.max_views);
   out.views_used = static_cast<int>(views.size());
   if (views.size() < std::max<size_t>(options.min_views, 2)) {
     out.status = BoxEllipsoidStatus::TooFewViews;
@@ -138,19 +164,49 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
     }
     radii.push_back(0.25 * (v.box.width() / K.fx + v.box.height() / K.fy) * z);
   }
+  // Semi-axis bounds from the prior; the initial radius within them.
+  Eigen::Vector3d typical = prior.typical_semi_axes;
+  std::sort(typical.data(), typical.data() + 3);
+  double lo = 1e-3, hi = 1e3;
+  if (options.use_size_prior) {
+    lo = std::max(prior.min_axis, typical(0) / prior.range_factor);
+    hi = std::max(lo * 2.0, std::min(prior.max_axis, typical(2) * prior.range_factor));
+  }
   double c[3] = {centre->x(), centre->y(), centre->z()};
-  const double log_r = std::log(std::max(1e-3, median(radii)));
+  const double log_r = std::log(std::clamp(median(radii), lo, hi));
   double s[3] = {log_r, log_r, log_r};
   double w[3] = {0.0, 0.0, 0.0};
+  const Eigen::Matrix3d base = options.up ? groundBasis(*options.up) : Eigen::Matrix3d::Identity();
 
   ceres::Problem problem;
   for (const BoxView& v : views) {
     const auto e = Ellipse::inscribedInBox(v.box);
     if (!e) continue;
-    auto* cost = new BoxW2Cost{projectionMatrix(K, v.pose), v.pose, *e, std::sqrt(e->axes().prod())};
+    auto* cost = new BoxW2Cost{projectionMatrix(K, v.pose), v.pose, *e, std::sqrt(e->axes().prod()), base};
+    double probe[6];
+    const double* params[3] = {c, s, w};
+    if (!(*cost)(params[0], params[1], params[2], probe)) {  // a camera inside the start sphere
+      delete cost;
+      continue;
+    }
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BoxW2Cost, 6, 3, 3, 3>(cost), new ceres::HuberLoss(0.5), c,
                              s, w);
   }
+  if (problem.NumResidualBlocks() < static_cast<int>(std::max<size_t>(options.min_views, 2))) {
+    out.status = BoxEllipsoidStatus::TooFewViews;
+    out.reason = std::to_string(problem.NumResidualBlocks()) + " views see the object from outside";
+    return out;
+  }
+  if (options.use_size_prior) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SizePriorCost, 3, 3>(
+                                 new SizePriorCost{typical.array().log().matrix(), prior.sigma_log}),
+                             nullptr, s);
+    for (int k = 0; k < 3; ++k) {
+      problem.SetParameterLowerBound(s, k, std::log(lo));
+      problem.SetParameterUpperBound(s, k, std::log(hi));
+    }
+  }
+  if (options.up) problem.SetManifold(w, new ceres::SubsetManifold(3, {0, 1}));  // yaw about up only
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
   solver.max_num_iterations = options.max_iterations;
@@ -161,7 +217,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
 
   double R_data[9];
   ceres::AngleAxisToRotationMatrix(w, ceres::ColumnMajorAdapter3x3(R_data));
-  const Eigen::Matrix3d R = nearestRotation(Eigen::Map<const Eigen::Matrix3d>(R_data));
+  const Eigen::Matrix3d R = nearestRotation(base * Eigen::Map<const Eigen::Matrix3d>(R_data));
   out.ellipsoid =
       Ellipsoid(Eigen::Vector3d(c[0], c[1], c[2]), Eigen::Vector3d(std::exp(s[0]), std::exp(s[1]), std::exp(s[2])), R);
   if (!out.ellipsoid.isValid()) {

@@ -6,6 +6,7 @@
 
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/error.hpp"
+#include "ellreloc/mapping/category_sizes.hpp"
 
 namespace ellreloc {
 namespace {
@@ -95,7 +96,17 @@ void Mapper::observed(Track& track, const Detection& detection) {
   track.last_seen = keyframes_;
   if (track.observations >= options_.min_observations) track.confirmed = true;
   if (track.confirmed && options_.mode == MappingMode::Voxel) track.voxels.prune(options_.prune_probability);
-  if (track.confirmed) rebuild(track);
+  // Box fits are refitted when the views grew by an eighth since the last fit (and by
+  // finish()): refitting at every view would cost quadratic time in the views of an object.
+  const bool box_fit_due = options_.mode == MappingMode::Voxel || track.built_views == 0 ||
+                           8 * (track.views.size() - track.built_views) >= track.built_views;
+  if (track.confirmed && box_fit_due) rebuild(track);
+}
+
+void Mapper::finish() {
+  std::unique_lock lock(mutex_);
+  for (Track& t : tracks_)
+    if (t.confirmed && options_.mode == MappingMode::Boxes && t.built_views != t.views.size()) rebuild(t);
 }
 
 void Mapper::rebuild(Track& track) const {
@@ -114,7 +125,10 @@ void Mapper::rebuild(Track& track) const {
     m.voxels = track.voxels.size();
     m.memory_bytes = track.voxels.memoryBytes();
   } else {
-    const BoxEllipsoidResult r = buildEllipsoidFromBoxes(K_, track.views, options_.boxes);
+    BoxSizePrior prior;
+    prior.typical_semi_axes = typicalSemiAxes(m.object.category);
+    const BoxEllipsoidResult r = buildEllipsoidFromBoxes(K_, track.views, options_.boxes, prior);
+    track.built_views = track.views.size();
     if (!r.ok()) {
       track.built.reset();  // boxes that no longer agree: out of the map until they do
       return;

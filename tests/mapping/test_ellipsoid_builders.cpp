@@ -5,6 +5,7 @@
 
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
+#include "ellreloc/mapping/category_sizes.hpp"
 #include "ellreloc/mapping/ellipsoid_builder.hpp"
 
 namespace ellreloc {
@@ -138,6 +139,40 @@ TEST(BoxEllipsoidBuilder, StatusesInsteadOfGuesses) {
   const BoxEllipsoidResult r = buildEllipsoidFromBoxes(kK, with_nan);
   EXPECT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.views_used, 5);
+}
+
+// Boxes from a 10 degree arc leave the depth of a thin object (a book, 4 x 17 x 24 cm, seen
+// face-on) almost unobserved. The size prior keeps every axis within the category's bounds:
+// the fit is a book-sized ellipsoid, not a disc with a sub-millimetre axis or a needle.
+TEST(BoxEllipsoidBuilder, SizePriorKeepsAnUnobservedAxisNearTheCategorysSize) {
+  const Eigen::Vector3d book_axes = typicalSemiAxes(73);
+  const Ellipsoid truth(Eigen::Vector3d(0.5, 1.0, 0.4), Eigen::Vector3d(book_axes(0), book_axes(1), book_axes(2)),
+                        Eigen::Matrix3d::Identity());  // thin along x, which the cameras look along
+  const std::vector<BoxView> views = ringViews(truth, 8, 1.5, 10.0);
+  BoxSizePrior prior;
+  prior.typical_semi_axes = book_axes;
+  const BoxEllipsoidResult r = buildEllipsoidFromBoxes(kK, views, {}, prior);  // without it: an axis of 0.08 mm
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const Eigen::Vector3d axes = r.ellipsoid.axes();
+  EXPECT_GE(axes.minCoeff(), book_axes.minCoeff() / prior.range_factor - 1e-9);
+  EXPECT_LE(axes.maxCoeff(), book_axes.maxCoeff() * prior.range_factor + 1e-9);
+  // The extent along the viewing direction (world x) is within a factor 3 of the book's.
+  const double depth_extent = std::sqrt((r.ellipsoid.shapeMatrix())(0, 0));
+  EXPECT_GT(depth_extent, book_axes(0) / 3.0);
+  EXPECT_LT(depth_extent, book_axes(0) * 3.0);
+  EXPECT_GT(r.median_iou, 0.85);
+}
+
+// Sizes exist for all 80 categories, are positive and sorted; unknown ids get a generic size.
+TEST(CategorySizes, PlausibleForEveryCocoCategory) {
+  for (int c = 0; c < 80; ++c) {
+    const Eigen::Vector3d a = typicalSemiAxes(c);
+    EXPECT_GT(a(0), 0.004) << c;
+    EXPECT_LE(a(0), a(1)) << c;
+    EXPECT_LE(a(1), a(2)) << c;
+  }
+  EXPECT_NEAR(typicalSemiAxes(41).maxCoeff(), 0.055, 1e-9);  // a cup: 11 cm tall
+  EXPECT_EQ(typicalSemiAxes(-1), typicalSemiAxes(80));
 }
 
 }  // namespace

@@ -5,8 +5,10 @@
 /// is triangulated from the rays through the box centres, the semi-axes start from the box
 /// sizes at that depth, and the 9-DoF ellipsoid (centre, semi-axes, rotation) is refined by
 /// minimising the squared Wasserstein distance between each box-inscribed ellipse and the
-/// ellipsoid's projection (Ceres). Objects whose projections keep overlapping their boxes
-/// poorly are rejected.
+/// ellipsoid's projection (Ceres). A size prior keeps an axis the boxes leave unobserved (the
+/// depth of an object seen from one side) near its category's typical size, and bounds every
+/// semi-axis, so no fit degenerates to a disc or a needle. Objects whose projections keep
+/// overlapping their boxes poorly are rejected.
 
 #include <Eigen/Core>
 #include <optional>
@@ -25,6 +27,19 @@ struct BoxView {
   Box box;
 };
 
+/// What is known of an object's size before its boxes: its category's typical semi-axes
+/// (category_sizes.hpp). Each log semi-axis, sorted, is pulled towards the typical one sorted,
+/// with a standard deviation of sigma_log (so the prior never fixes the orientation), and every
+/// semi-axis stays within [smallest typical / range_factor, largest typical * range_factor],
+/// itself within [min_axis, max_axis].
+struct BoxSizePrior {
+  Eigen::Vector3d typical_semi_axes = Eigen::Vector3d::Constant(0.15);
+  double sigma_log = 1.0;  ///< weak: it decides what the boxes leave open
+  double range_factor = 4.0;
+  double min_axis = 0.005;  ///< metres
+  double max_axis = 5.0;
+};
+
 struct BoxEllipsoidOptions {
   size_t min_views = 3;
   /// The rays to the object must span at least this angle, else depth is unobservable.
@@ -36,6 +51,13 @@ struct BoxEllipsoidOptions {
   /// box stays below this after refinement.
   double min_median_iou = 0.5;
   int max_iterations = 100;
+  /// At most this many views enter the fit, evenly spread over the given order (time), which
+  /// bounds the cost of a fit for an object seen in thousands of frames.
+  size_t max_views = 60;
+  bool use_size_prior = true;
+  /// When set (world coordinates, against gravity), the ellipsoid stands upright: its third
+  /// axis is `up` and only its yaw is fitted, as the paper's RGB-D ellipsoids (PCA yaw).
+  std::optional<Eigen::Vector3d> up;
 };
 
 enum class BoxEllipsoidStatus {
@@ -60,7 +82,7 @@ struct BoxEllipsoidResult {
 
 /// Builds an object's ellipsoid from its boxes. Never throws; invalid input gives a status.
 BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vector<BoxView>& views,
-                                           const BoxEllipsoidOptions& options = {});
+                                           const BoxEllipsoidOptions& options = {}, const BoxSizePrior& prior = {});
 
 /// The centre least-squares closest to the rays through the box centres (nullopt when the
 /// rays are parallel or the input is invalid). Exposed for the mapper's association.

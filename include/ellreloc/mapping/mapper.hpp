@@ -99,6 +99,11 @@ class Mapper {
   KeyframeReport addKeyframe(const Pose& pose, const std::vector<Detection>& detections,
                              const DepthImage* depth = nullptr);
 
+  /// Boxes mode: refits every object whose views grew since its last fit (objects are refitted
+  /// as their views grow, not at every view). Call after the last keyframe; voxel mode needs
+  /// nothing.
+  void finish();
+
   /// The objects in the map (those with an ellipsoid), in the order they were created.
   ObjectMap map() const;
   std::vector<MappedObject> objects() const;
@@ -116,6 +121,7 @@ class Mapper {
     int last_seen = -1;
     bool confirmed = false;
     std::optional<MappedObject> built;  // rebuilt after each update of a confirmed object
+    size_t built_views = 0;             // boxes mode: views in the last fit
     int label() const;
   };
   void checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const;
