@@ -117,7 +117,9 @@ std::vector<RelocalizationResult> relocalizeFrames(const ObjectRelocalizer& relo
 
 int relocalize(const RelocalizeArgs& a, const Console& console) {
   const Intrinsics K = io::readCamera(a.camera);
-  const ObjectMap object_map = io::readMap(a.map);
+  std::vector<std::string> left_out;
+  const ObjectMap object_map = io::readMap(a.map, &left_out);
+  for (const std::string& w : left_out) std::fprintf(stderr, "warning: %s\n", w.c_str());
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   RelocalizerOptions options;
   std::string policy = a.policy;

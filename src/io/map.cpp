@@ -18,9 +18,14 @@ using detail::Where;
 /// this tolerance and return the nearest exact rotation.
 constexpr double kRotationTolerance = 1e-3;
 
-Ellipsoid ellipsoidFromDualQuadric(const Eigen::Matrix4d& Q, const Where& where) {
+/// An object that cannot be used: left out of the map with a warning naming it.
+struct Unusable {
+  std::string reason;
+};
+
+Ellipsoid ellipsoidFromDualQuadric(const Eigen::Matrix4d& Q, const std::string& where) {
   const auto e = Ellipsoid::fromDualQuadric(Q);
-  if (!e) where.fail("does not describe a real ellipsoid");
+  if (!e) throw Unusable{where + ": the dual quadric is singular or not an ellipsoid"};
   return *e;
 }
 
@@ -28,7 +33,7 @@ Ellipsoid parseObjectGeometry(const json& obj, const Where& where) {
   if (obj.contains("center") || !obj.contains("dual_quadric")) {
     const Eigen::Vector3d c = detail::vector<3>(detail::member(obj, "center", where), where["center"]);
     const Eigen::Vector3d axes = detail::vector<3>(detail::member(obj, "axes", where), where["axes"]);
-    if (axes.minCoeff() <= 0.0) where["axes"].fail("semi-axes must be positive");
+    if (!(axes.minCoeff() > 0.0)) throw Unusable{where["axes"].path + ": semi-axes must be positive"};
     const json& rot = detail::member(obj, "rotation", where);
     if (!rot.is_array() || rot.size() != 3) where["rotation"].fail("expected 3 rows of 3 numbers");
     Eigen::Matrix3d R;
@@ -42,12 +47,30 @@ Ellipsoid parseObjectGeometry(const json& obj, const Where& where) {
   Eigen::Matrix4d Q;
   for (size_t i = 0; i < 16; ++i)
     Q(static_cast<int>(i / 4), static_cast<int>(i % 4)) = detail::finiteNumber(q[i], where["dual_quadric"][i]);
-  return ellipsoidFromDualQuadric(Q, where["dual_quadric"]);
+  return ellipsoidFromDualQuadric(Q, where["dual_quadric"].path);
+}
+
+/// Keeps `object` or, when unusable, leaves it out with a warning naming it.
+void keepIfUsable(MapObject object, const std::string& problem, const std::string& source, ObjectMap* map,
+                  std::vector<std::string>* warnings) {
+  const std::string why = problem.empty() ? mapObjectProblem(object) : problem;
+  if (why.empty()) {
+    map->objects.push_back(std::move(object));
+    return;
+  }
+  if (warnings) warnings->push_back(source + ": object " + std::to_string(object.id) + " left out: " + why);
+}
+
+/// No usable object is an error: relocalization against nothing cannot succeed.
+void requireObjects(const ObjectMap& map, const std::vector<std::string>& left_out, const std::string& source) {
+  if (!map.objects.empty()) return;
+  if (left_out.empty()) throw Error(source + ": no objects found (empty or blank map file)");
+  throw Error(left_out.front() + (left_out.size() > 1 ? " (and every other object)" : "") + "; no usable object");
 }
 
 }  // namespace
 
-ObjectMap parseMapJson(const std::string& text, const std::string& source) {
+ObjectMap parseMapJson(const std::string& text, const std::string& source, std::vector<std::string>* warnings) {
   const json j = detail::parseJson(text, source);
   const Where top{source, ""};
   if (!j.is_object()) top.fail("expected a JSON object with \"objects\"");
@@ -59,6 +82,7 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
   const json& objects = detail::member(j, "objects", top);
   if (!objects.is_array()) top["objects"].fail("expected an array");
   ObjectMap map;
+  std::vector<std::string> left_out;
   for (size_t i = 0; i < objects.size(); ++i) {
     const Where where = top["objects"][i];
     const json& o = objects[i];
@@ -70,7 +94,12 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
       if (!o["label"].is_string()) where["label"].fail("expected a string");
       obj.label = o["label"].get<std::string>();
     }
-    obj.ellipsoid = parseObjectGeometry(o, where);
+    std::string problem;
+    try {
+      obj.ellipsoid = parseObjectGeometry(o, where);
+    } catch (const Unusable& u) {
+      problem = u.reason;
+    }
     if (o.contains("category_counts")) {
       const json& counts = o["category_counts"];
       const Where wc = where["category_counts"];
@@ -85,8 +114,10 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
         obj.category_counts[static_cast<int>(c)] = n;
       }
     }
-    map.objects.push_back(std::move(obj));
+    keepIfUsable(std::move(obj), problem, source, &map, &left_out);
   }
+  requireObjects(map, left_out, source);
+  if (warnings) warnings->insert(warnings->end(), left_out.begin(), left_out.end());
   if (j.contains("points")) {
     const json& points = j["points"];
     if (!points.is_array()) top["points"].fail("expected an array of [x, y, z]");
@@ -96,8 +127,9 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source) {
   return map;
 }
 
-ObjectMap parseOaSlamMap(const std::string& text, const std::string& source) {
+ObjectMap parseOaSlamMap(const std::string& text, const std::string& source, std::vector<std::string>* warnings) {
   ObjectMap map;
+  std::vector<std::string> left_out;
   forEachDataLine(text, [&](int line_no, const std::string& line) {
     const Where where{source, "line " + std::to_string(line_no)};
     std::istringstream fields(line);
@@ -115,18 +147,24 @@ ObjectMap parseOaSlamMap(const std::string& text, const std::string& source) {
     MapObject obj;
     obj.id = static_cast<int>(id);
     obj.category = static_cast<int>(category);
-    obj.ellipsoid = ellipsoidFromDualQuadric(Q, where);
-    map.objects.push_back(std::move(obj));
+    std::string problem;
+    try {
+      obj.ellipsoid = ellipsoidFromDualQuadric(Q, where.path);
+    } catch (const Unusable& u) {
+      problem = u.reason;
+    }
+    keepIfUsable(std::move(obj), problem, source, &map, &left_out);
   });
-  if (map.objects.empty()) throw Error(source + ": no objects found (empty or blank map file)");
+  requireObjects(map, left_out, source);
+  if (warnings) warnings->insert(warnings->end(), left_out.begin(), left_out.end());
   return map;
 }
 
-ObjectMap readMap(const std::string& path) {
+ObjectMap readMap(const std::string& path, std::vector<std::string>* warnings) {
   const std::string text = readTextFile(path);
   const size_t first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) throw Error(path + ": empty file, expected a map");
-  return text[first] == '{' ? parseMapJson(text, path) : parseOaSlamMap(text, path);
+  return text[first] == '{' ? parseMapJson(text, path, warnings) : parseOaSlamMap(text, path, warnings);
 }
 
 void writeMap(const std::string& path, const ObjectMap& map) {

@@ -60,7 +60,11 @@ std::string invalidInput(const Intrinsics& K, const std::optional<GravityPrior>&
 }  // namespace
 
 ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
-    : map_(std::move(map)), K_(K), options_(std::move(options)) {}
+    : map_(std::move(map)), K_(K), options_(std::move(options)) {
+  for (const MapObject& o : map_.objects)
+    if (const std::string problem = mapObjectProblem(o); !problem.empty())
+      left_out_.push_back("object " + std::to_string(o.id) + ": " + problem);
+}
 
 RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>& observations,
                                                   const Pose& pose) const {

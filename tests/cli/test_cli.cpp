@@ -150,6 +150,24 @@ TEST(Cli, Fr2DeskKeyframesStayAboveTheMeasuredFloor) {
   EXPECT_LE(pos, 15.0);
 }
 
+// A map object with a collapsed axis is left out with a warning naming it; the run goes on.
+TEST(Cli, DegenerateMapObjectsAreReportedAndLeftOut) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr2_desk");
+  writeFile(dir.path("map.json"),
+            "{\"objects\": [{\"id\": 4, \"category\": 41, \"center\": [0, 0, 1], \"axes\": [0.05, 2e-7, 0.05], "
+            "\"rotation\": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}, {\"id\": 5, \"category\": 41, \"center\": [0, 1, 1], "
+            "\"axes\": [0.05, 0.05, 0.05], \"rotation\": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}]}");
+  const CliRun r = run("relocalize --camera " + d + "/camera.yaml --map " + dir.path("map.json") + " --detections " +
+                           d + "/keyframes.detections.json --out " + dir.path("poses.txt"),
+                       dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: " + dir.path("map.json") + ": object 4 left out: semi-axis 2e-07 m is below 1 mm"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("object 5"), std::string::npos) << r.err;
+}
+
 TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
   ellreloc::test::TempDir dir;
   const std::string d = data("tum_fr2_desk");

@@ -106,13 +106,13 @@ TEST(MapIo, MalformedMapsNameTheFileAndField) {
       {R"({"objects": [{"id": "a", "category": 41}]})", "objects[0].id: expected an integer"},
       {R"({"objects": [{"id": 1, "category": 41.5}]})", "objects[0].category: expected an integer"},
       {R"({"objects": [{"id": 1, "category": 41, "center": [0, "x", 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].center[1]: expected a number"},
-      {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]})", "objects[0].dual_quadric: does not describe a real ellipsoid"},
+      {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]})", "objects[0].dual_quadric: the dual quadric is singular"},
       {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0]}]})", "objects[0].dual_quadric: expected 16"},
       {"{\"objects\": [" + obj + "], \"points\": [[1, 2]]}", "points[0]: expected an array of 3"},
       {"{\"objects\": [" + obj + ", 5]}", "objects[1]: expected an object"},
       {"7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0\n", "line 1: expected 16 dual-quadric entries, found 15"},
       {"7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 -1 9\n", "line 1: unexpected trailing text"},
-      {"# comment\n7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n", "line 2: does not describe a real ellipsoid"},
+      {"# comment\n7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n", "line 2: the dual quadric is singular"},
       {"seven 41\n", "line 1: expected 'track_id category_id'"},
       {"7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 nan\n", "line 1"},
   };
@@ -131,6 +131,42 @@ TEST(MapIo, MalformedMapsNameTheFileAndField) {
       EXPECT_EQ(what.find('\n'), std::string::npos) << what;
     }
   }
+}
+
+// Well-formed objects that cannot be used are left out with a warning naming each; the rest
+// of the map is read.
+TEST(MapIo, UnusableObjectsAreLeftOutWithAWarningEach) {
+  const auto object = [](int id, const std::string& axes) {
+    return "{\"id\": " + std::to_string(id) + ", \"category\": 41, \"center\": [0, 0, 1], \"axes\": [" + axes +
+           "], \"rotation\": [[1,0,0],[0,1,0],[0,0,1]]}";
+  };
+  test::TempDir dir;
+  const std::string path = dir.path("map.json");
+  io::writeFileAtomically(path, "{\"objects\": [" + object(1, "0.1, 0.2, 0.3") + ", " + object(2, "0.1, 1e-19, 0.3") +
+                                    ", " + object(3, "0.1, 12, 0.3") + ", " + object(4, "0.1, 0, 0.3") + "]}");
+  std::vector<std::string> warnings;
+  const ObjectMap map = io::readMap(path, &warnings);
+  ASSERT_EQ(map.objects.size(), 1u);
+  EXPECT_EQ(map.objects[0].id, 1);
+  ASSERT_EQ(warnings.size(), 3u);
+  const std::vector<std::string> expected = {"object 2 left out: semi-axis 1e-19 m is below 1 mm",
+                                             "object 3 left out: semi-axis 12 m is above 10 m",
+                                             "object 4 left out: objects[3].axes: semi-axes must be positive"};
+  for (size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(warnings[i].rfind(path + ": ", 0), 0u) << warnings[i];
+    EXPECT_NE(warnings[i].find(expected[i]), std::string::npos) << warnings[i];
+  }
+  // OA-SLAM text: a singular dual quadric on line 2, a sphere of radius 0.5 on line 3.
+  const std::string text = dir.path("map.txt");
+  io::writeFileAtomically(text, "7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n8 41 0.25 0 0 0 0 0.25 0 0 0 0 0.25 0 0 0 0 -1\n");
+  warnings.clear();
+  const ObjectMap oa = io::readMap(text, &warnings);
+  ASSERT_EQ(oa.objects.size(), 1u);
+  EXPECT_EQ(oa.objects[0].id, 8);
+  EXPECT_NEAR(oa.objects[0].ellipsoid.axes().maxCoeff(), 0.5, 1e-12);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("object 7 left out: line 1: the dual quadric is singular"), std::string::npos)
+      << warnings[0];
 }
 
 TEST(MapIo, WritingAnInvalidMapLeavesNoFile) {

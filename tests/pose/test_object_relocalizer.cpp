@@ -436,3 +436,26 @@ TEST(ObjectRelocalizer, MinorityLabelsWeighLess) {
   EXPECT_NEAR(weighed.cost, 1.0 - 0.2 * overlap, 1e-9);
   EXPECT_NEAR(plain.cost, 1.0 - overlap, 1e-9);
 }
+
+// Objects a map cannot use (a collapsed axis, an absurd one) are never matched and said so;
+// the pose still comes from the others.
+TEST(ObjectRelocalizer, LeavesOutDegenerateMapObjects) {
+  std::mt19937 rng(5);
+  const Synthetic s = makeSceneSeeing(rng, 6, 12, 6);
+  ObjectMap map = s.map;
+  map.objects[static_cast<size_t>(s.object_of[0])].ellipsoid =
+      Ellipsoid(map.objects[static_cast<size_t>(s.object_of[0])].ellipsoid.center(), {0.1, 1e-19, 0.1},
+                Eigen::Matrix3d::Identity());
+  map.objects[static_cast<size_t>(s.object_of[1])].ellipsoid =
+      Ellipsoid({0, 0, 0}, {0.1, 25.0, 0.1}, Eigen::Matrix3d::Identity());
+  const ObjectRelocalizer reloc(map, test::testIntrinsics());
+  ASSERT_EQ(reloc.leftOut().size(), 2u);
+  EXPECT_NE(reloc.leftOut()[0].find("below 1 mm"), std::string::npos) << reloc.leftOut()[0];
+  const RelocalizationResult r = reloc.relocalize(s.observations);
+  ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
+  EXPECT_LT(positionError(r.pose, s.truth), 0.05);
+  for (const ObjectCorrespondence& m : r.inliers) {
+    EXPECT_NE(m.object, s.object_of[0]);
+    EXPECT_NE(m.object, s.object_of[1]);
+  }
+}

@@ -3,6 +3,7 @@
 /// A map of objects (ellipsoids with categories) and, optionally, 3D feature points.
 
 #include <Eigen/Core>
+#include <cstdio>
 #include <map>
 #include <string>
 #include <vector>
@@ -37,5 +38,37 @@ struct ObjectMap {
   std::vector<MapObject> objects;
   std::vector<Eigen::Vector3d> points;  ///< optional map points, indexed by keypoint matches
 };
+
+/// Semi-axes outside [kMinSemiAxis, kMaxSemiAxis] metres make an object unusable: a
+/// sub-millimetre axis is a degenerate fit (a disc or a needle), above 10 m no indoor object.
+constexpr double kMinSemiAxis = 1e-3;
+constexpr double kMaxSemiAxis = 10.0;
+
+/// Why `object` cannot be used for relocalization, in a few words, or "" when it can: a
+/// non-finite centre or rotation, a semi-axis non-finite or outside [kMinSemiAxis,
+/// kMaxSemiAxis], or a rotation that is not one.
+inline std::string mapObjectProblem(const MapObject& object) {
+  const Ellipsoid& e = object.ellipsoid;
+  if (!e.center().allFinite()) return "centre is not finite";
+  if (!e.axes().allFinite()) return "a semi-axis is not finite";
+  char text[64];
+  if (!(e.axes().minCoeff() >= kMinSemiAxis)) {
+    std::snprintf(text, sizeof text, "semi-axis %.3g m is below 1 mm", e.axes().minCoeff());
+    return text;
+  }
+  if (!(e.axes().maxCoeff() <= kMaxSemiAxis)) {
+    std::snprintf(text, sizeof text, "semi-axis %.3g m is above 10 m", e.axes().maxCoeff());
+    return text;
+  }
+  if (!isRotation(e.rotation())) return "rotation is not a rotation matrix";
+  return "";
+}
+
+/// mapObjectProblem(object) is empty, without building the text.
+inline bool mapObjectUsable(const MapObject& object) {
+  const Ellipsoid& e = object.ellipsoid;
+  return e.center().allFinite() && e.axes().allFinite() && e.axes().minCoeff() >= kMinSemiAxis &&
+         e.axes().maxCoeff() <= kMaxSemiAxis && isRotation(e.rotation());
+}
 
 }  // namespace ellreloc

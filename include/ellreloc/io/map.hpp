@@ -6,19 +6,26 @@
 #include "ellreloc/core/object_map.hpp"
 
 #include <string>
+#include <vector>
 
 namespace ellreloc::io {
 
 /// Reads a map file: JSON when the first non-blank character is '{', otherwise OA-SLAM's text
 /// format. Rotations within 1e-3 of orthonormal (rounded files) are projected onto the nearest
 /// rotation. Throws ellreloc::Error naming the file and the field or line on malformed input.
-ObjectMap readMap(const std::string& path);
+/// A well-formed object that cannot be used (mapObjectProblem: a zero, negative, non-finite,
+/// sub-millimetre or > 10 m semi-axis, a singular dual quadric) is left out of the map, with
+/// one line per object in `warnings` ("FILE: object ID left out: WHY"); a map left without
+/// any object is an Error.
+ObjectMap readMap(const std::string& path, std::vector<std::string>* warnings = nullptr);
 
-/// Parses map JSON text; `source` names it in error messages.
-ObjectMap parseMapJson(const std::string& text, const std::string& source);
+/// Parses map JSON text; `source` names it in error and warning messages.
+ObjectMap parseMapJson(const std::string& text, const std::string& source,
+                       std::vector<std::string>* warnings = nullptr);
 
-/// Parses OA-SLAM's text map; `source` names it in error messages.
-ObjectMap parseOaSlamMap(const std::string& text, const std::string& source);
+/// Parses OA-SLAM's text map; `source` names it in error and warning messages.
+ObjectMap parseOaSlamMap(const std::string& text, const std::string& source,
+                         std::vector<std::string>* warnings = nullptr);
 
 /// Writes the JSON map (centre/axes/rotation form), atomically.
 void writeMap(const std::string& path, const ObjectMap& map);

@@ -68,6 +68,9 @@ struct RelocalizationResult {
 /// can serve many threads at once.
 class ObjectRelocalizer {
  public:
+  /// Objects of `map` that cannot be used (mapObjectProblem: degenerate or absurd semi-axes,
+  /// non-finite values) are never matched; leftOut() says which and why. Results index the
+  /// objects of `map` as given.
   ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options = {});
 
   RelocalizationResult relocalize(const std::vector<Observation>& observations) const;
@@ -92,11 +95,14 @@ class ObjectRelocalizer {
   RelocalizationResult scorePose(const std::vector<Observation>& observations, const Pose& pose) const;
 
   const ObjectMap& map() const { return map_; }
+  /// "object ID: WHY" for each object of the map that is never matched.
+  const std::vector<std::string>& leftOut() const { return left_out_; }
   const Intrinsics& intrinsics() const { return K_; }
   const RelocalizerOptions& options() const { return options_; }
 
  private:
   ObjectMap map_;
+  std::vector<std::string> left_out_;
   Intrinsics K_;
   RelocalizerOptions options_;
 };
