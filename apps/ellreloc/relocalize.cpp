@@ -1,6 +1,7 @@
 // `ellreloc relocalize`.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -32,6 +33,11 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
   r->add_option("--policy", a.policy, "observation policy (default: paper for ours, bbox for oa-slam)");
   r->add_option("--out", a.out, "TUM poses of the relocalized frames")->required();
   r->add_option("--report", a.report, "per-frame JSON report: status, inliers, score, time");
+  r->add_option("--reference", a.reference,
+                "TUM poses to diagnose against (the ground truth, or another method's output): the report gives "
+                "each frame's reference pose score under our cost and, for a pose off by >= 30 cm or 30 deg, "
+                "whether the search missed a better pose or the score preferred a wrong one")
+      ->check(CLI::ExistingFile);
   r->add_option("--points", a.points,
                 "refine with keypoints matched to the map's points: from this file (same frame "
                 "layout), or from the detections file when no file is given")
@@ -63,14 +69,21 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
 
 namespace {
 
+/// A reference pose under our cost: as given, and refined as our hypotheses are.
+struct ReferenceScore {
+  RelocalizationResult given, refined;
+};
+
 /// Observes and relocalizes every frame on `threads` worker threads; `observed` receives each
-/// frame's number of observations.
+/// frame's number of observations, `reference_scores` the score of each frame's reference pose.
 std::vector<RelocalizationResult> relocalizeFrames(const ObjectRelocalizer& relocalizer,
                                                    const std::vector<DetectionFrame>& frames,
                                                    const std::vector<std::vector<Keypoint>>& keypoints,
                                                    const std::optional<GravityPrior>& gravity,
-                                                   const ObserveOptions& observe_options, int threads,
-                                                   const Console& console, std::vector<int>* observed_out) {
+                                                   const ObserveOptions& observe_options,
+                                                   const std::vector<std::optional<Pose>>& references, int threads,
+                                                   const Console& console, std::vector<int>* observed_out,
+                                                   std::vector<ReferenceScore>* reference_scores) {
   // Frames are independent: `threads` workers take the next frame until none is left (the
   // calling thread only shows progress). The first exception of any worker stops the others
   // and is rethrown here, so a worker's failure is reported like the calling thread's.
@@ -90,6 +103,9 @@ std::vector<RelocalizationResult> relocalizeFrames(const ObjectRelocalizer& relo
             observations.push_back(*r.observation);
         observed[i] = static_cast<int>(observations.size());
         results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
+        if (references[i])
+          (*reference_scores)[i] = {relocalizer.scorePose(observations, *references[i]),
+                                    relocalizer.refineFrom(observations, *references[i])};
         ++finished;
       }
     } catch (...) {
@@ -111,6 +127,20 @@ std::vector<RelocalizationResult> relocalizeFrames(const ObjectRelocalizer& relo
   for (std::thread& w : workers) w.join();
   if (failure) std::rethrow_exception(failure);
   return results;
+}
+
+/// How a frame's result compares with its reference pose: "valid" (within 30 cm and 30 deg of
+/// it); "no pose" when none was returned; "search failure" when the reference explains the
+/// frame better under our own cost, as given or refined (when refinement keeps it valid): we
+/// never generated it; "scoring failure" when our wrong pose scores better than both: the
+/// score cannot tell them apart.
+std::string diagnose(const RelocalizationResult& result, const ReferenceScore& reference, const Pose& truth) {
+  if (result.status != RelocalizationStatus::Success) return "no pose";
+  if (poseError(result.pose, truth).valid()) return "valid";
+  double best = reference.given.cost;
+  if (reference.refined.status == RelocalizationStatus::Success && poseError(reference.refined.pose, truth).valid())
+    best = std::min(best, reference.refined.cost);
+  return best < result.cost ? "search failure" : "scoring failure";
 }
 
 }  // namespace
@@ -151,10 +181,22 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
       keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
   }
 
+  std::vector<std::optional<Pose>> references(frames.size());
+  if (!a.reference.empty()) {
+    const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.reference, true);
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const std::optional<double> t = frames[i].timestamp();
+      if (const auto k = t ? io::findNearest(trajectory, *t) : std::nullopt) references[i] = trajectory[*k].pose;
+    }
+  }
+
   std::vector<int> observed(frames.size(), 0);
+  std::vector<ReferenceScore> reference_scores(frames.size());
   const std::vector<RelocalizationResult> results =
-      relocalizeFrames(relocalizer, frames, keypoints, gravity, observe_options, a.threads, console, &observed);
+      relocalizeFrames(relocalizer, frames, keypoints, gravity, observe_options, references, a.threads, console,
+                       &observed, &reference_scores);
   console.endProgress();
+  std::map<std::string, int> diagnoses;
 
   std::vector<io::StampedPose> poses;
   nlohmann::json report = nlohmann::json::array();
@@ -171,6 +213,17 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
                          {"object_id", object_map.objects[static_cast<size_t>(c.object)].id},
                          {"overlap", c.overlap}});
     j["matches"] = matches;
+    if (references[i]) {
+      const std::string diagnosis = diagnose(r, reference_scores[i], *references[i]);
+      ++diagnoses[diagnosis];
+      const ReferenceScore& ref = reference_scores[i];
+      j["reference"] = {{"score", ref.given.cost},
+                        {"inliers", ref.given.inliers.size()},
+                        {"refined_score", ref.refined.cost},
+                        {"refined_inliers", ref.refined.inliers.size()},
+                        {"refined_moved_cm", poseError(ref.refined.pose, *references[i]).position_cm},
+                        {"diagnosis", diagnosis}};
+    }
     report.push_back(j);
     if (r.status != RelocalizationStatus::Success) continue;
     const std::optional<double> t = frames[i].timestamp();
@@ -184,6 +237,13 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   if (!console.quiet)
     std::printf("wrote %s: %zu of %zu frames relocalized (%s), median %.1f ms per frame\n", a.out.c_str(), poses.size(),
                 frames.size(), a.method.c_str(), median(times));
+  if (!a.reference.empty()) {  // a result: printed even when quiet
+    std::printf("against %s:", a.reference.c_str());
+    for (const auto& [diagnosis, count] : diagnoses) std::printf(" %s %d,", diagnosis.c_str(), count);
+    std::printf(" no reference pose %zu\n", frames.size() - static_cast<size_t>(std::count_if(
+                                                               references.begin(), references.end(),
+                                                               [](const auto& p) { return p.has_value(); })));
+  }
   return static_cast<int>(poses.size());
 }
 

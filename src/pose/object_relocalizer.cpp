@@ -88,6 +88,27 @@ RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>
   return result;
 }
 
+RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation>& observations,
+                                                   const Pose& start) const {
+  RelocalizationResult result = scorePose(observations, start);
+  if (result.status == RelocalizationStatus::InvalidInput) return result;
+  std::vector<std::pair<int, std::string>> skipped;
+  const Candidates candidates = collectCandidates(observations, map_, options_.scoring, &skipped);
+  PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
+  const std::optional<GravityPrior> no_gravity;
+  const RefinementContext context{observations, map_, K_, options_, no_gravity, GravityGate{nullptr, 0.0}};
+  const ChosenPose refined = refineRounds(start, scorer, context);
+  result.pose = refined.pose;
+  result.cost = refined.cost;
+  result.refined = refined.refined;
+  reportMatches(refined.matches, &result);
+  const int needed = std::min(options_.scoring.min_inliers, std::max(candidates.num_usable, 1));
+  const bool enough = static_cast<int>(refined.matches.size()) >= needed;
+  result.status = enough ? RelocalizationStatus::Success : RelocalizationStatus::NoConsistentHypothesis;
+  result.reason = enough ? "" : "the pose explains " + std::to_string(refined.matches.size()) + " observation(s)";
+  return result;
+}
+
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations) const {
   return relocalize(observations, {}, std::nullopt);
 }

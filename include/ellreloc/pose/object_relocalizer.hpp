@@ -94,6 +94,11 @@ class ObjectRelocalizer {
   /// cost, with Success when it explains scoring.min_inliers observations (fewer if fewer are usable).
   RelocalizationResult scorePose(const std::vector<Observation>& observations, const Pose& pose) const;
 
+  /// Refines a given pose (a motion model's prediction, a reference pose) against the objects
+  /// it matches, as relocalize() refines its hypotheses, and scores the result like scorePose.
+  /// `refined` says whether refinement moved it.
+  RelocalizationResult refineFrom(const std::vector<Observation>& observations, const Pose& start) const;
+
   const ObjectMap& map() const { return map_; }
   /// "object ID: WHY" for each object of the map that is never matched.
   const std::vector<std::string>& leftOut() const { return left_out_; }

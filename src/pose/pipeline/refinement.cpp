@@ -9,8 +9,8 @@ std::optional<GravityPrior> refinementGravity(const RefinementContext& c, size_t
   return matched < 3 || c.options.gravity.in_every_refinement ? c.gravity : std::nullopt;
 }
 
-/// Refine on the matches, match again at the refined pose, and repeat while that explains the
-/// observations better: a refined pose often brings more objects into overlap.
+}  // namespace
+
 ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementContext& c) {
   ChosenPose h;
   h.pose = start;
@@ -33,8 +33,6 @@ ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementC
   }
   return h;
 }
-
-}  // namespace
 
 std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>& matches,
                                          const std::vector<Observation>& observations, const ObjectMap& map) {

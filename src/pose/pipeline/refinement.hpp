@@ -29,6 +29,10 @@ struct RefinementContext {
   GravityGate gate;
 };
 
+/// Refines `start` on its matches, matches again at the refined pose, and repeats while that
+/// explains the observations better (a refined pose often brings more objects into overlap).
+ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementContext& context);
+
 /// Starts from `search_best` (the search's best pose) and refines every pooled hypothesis
 /// within refinement.cost_margin of the pool's best; returns the lowest-cost result.
 ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best, PoseScorer& scorer,
