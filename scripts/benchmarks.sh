@@ -43,6 +43,7 @@ if [ $quick = 1 ]; then
 else
   table reloc_accuracy "$bin/reloc_accuracy"
 fi
+table real_data python3 scripts/real_data.py "$build"
 table observe_accuracy "$bin/observe_accuracy"
 table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
 

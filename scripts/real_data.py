@@ -1,0 +1,87 @@
+#!/usr/bin/env python3
+"""The "real data" table of docs/benchmarks.md: ours against the OA-SLAM preset, in one run,
+on every real data set (and the independent renderer's scene), through the `ellreloc` command.
+
+  fr2_desk keyframes   the real GOReloc map, each keyframe relocalized from its YOLO boxes
+  fr3 60/40            map (`ellreloc map --mode boxes`, motion-capture poses) from the first
+                       60% of the fr3/long_office first half; every 5th frame of the rest queried
+  fr3 even/odd         map from the even frames, every odd frame queried
+  office_s11           the independent renderer's noisy map and its 100 query frames
+
+Usage: scripts/real_data.py [BUILD_DIR] [DATA_DIR]   (prints a Markdown table)
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+build = sys.argv[1] if len(sys.argv) > 1 else "build"
+data = sys.argv[2] if len(sys.argv) > 2 else "../shared/data"
+cli = os.path.join(build, "apps", "ellreloc", "ellreloc")
+
+
+def run(*args):
+    return subprocess.run([cli, *args], check=True, capture_output=True, text=True).stdout
+
+
+def relocalize(camera, map_path, detections, groundtruth, method, work):
+    out = os.path.join(work, "poses.txt")
+    printed = run("relocalize", "--camera", camera, "--map", map_path, "--detections", detections, "--method", method,
+                  "--threads", "2", "--out", out, "--reference", groundtruth)
+    ms = float(re.search(r"median ([0-9.]+) ms per frame", printed).group(1))
+    diagnosis = dict((k.strip(), int(v)) for v, k in
+                     [(m.group(2), m.group(1)) for m in re.finditer(r"([a-z ]+) (\d+)", printed.split(":", 1)[1])])
+    row = run("evaluate", "--groundtruth", groundtruth, "--estimate", out, "--detections", detections)
+    pos, rot, valid = [c.strip() for c in row.strip().splitlines()[-1].strip("|").split("|")][:3]
+    return {"valid": valid, "pos": pos, "rot": rot, "ms": ms, "diagnosis": diagnosis}
+
+
+def box_map(camera, trajectory, frames, holdout, work, name):
+    path = os.path.join(work, name + ".map.json")
+    printed = run("map", "--camera", camera, "--trajectory", trajectory, "--detections", frames, "--mode", "boxes",
+                  "--out", path, "--holdout", holdout)
+    objects = int(re.search(r": (\d+) objects", printed).group(1))
+    quality = float(re.search(r"IoU ([0-9.]+)", printed).group(1))
+    return path, "%d objects, held-out IoU %.2f" % (objects, quality)
+
+
+def main():
+    rows = []
+    with tempfile.TemporaryDirectory() as work:
+        fr2 = os.path.join(data, "tum_fr2_desk")
+        rows.append(("fr2_desk keyframes", "GOReloc map, 47 objects", os.path.join(fr2, "camera.yaml"),
+                     os.path.join(fr2, "map.json"), os.path.join(fr2, "keyframes.detections.json"),
+                     os.path.join(fr2, "keyframes.groundtruth.txt")))
+        fr3 = os.path.join(data, "tum_fr3_office_first_half")
+        camera, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
+        frames = json.load(open(os.path.join(fr3, "detections.json")))
+        cut = int(0.6 * len(frames))
+        splits = {"fr3 60/40": (frames[:cut], frames[cut::5]), "fr3 even/odd": (frames[0::2], frames[1::2])}
+        for name, (mapping, query) in splits.items():
+            tag = name.replace(" ", "_").replace("/", "_")
+            mapping_path, query_path = os.path.join(work, tag + ".map_frames.json"), os.path.join(work, tag + ".q.json")
+            json.dump(mapping, open(mapping_path, "w"))
+            json.dump(query, open(query_path, "w"))
+            map_path, what = box_map(camera, groundtruth, mapping_path, query_path, work, tag)
+            rows.append((name, "boxes map: " + what, camera, map_path, query_path, groundtruth))
+        s11 = os.path.join(data, "independent_synth", "office_s11")
+        rows.append(("office_s11 (independent renderer)", "its noisy map", os.path.join(s11, "camera.yaml"),
+                     os.path.join(s11, "map_noisy.json"), os.path.join(s11, "query.detections.json"),
+                     os.path.join(s11, "query.groundtruth.txt")))
+
+        print("| data | map | method | valid | median pos | median rot | median time | lost frames: no pose / "
+              "search / scoring failure |")
+        print("|---|---|---|---|---|---|---|---|")
+        for name, what, camera, map_path, detections, groundtruth in rows:
+            for method, label in (("ours", "ours"), ("oa-slam", "oa-slam preset")):
+                r = relocalize(camera, map_path, detections, groundtruth, method, work)
+                d = r["diagnosis"]
+                lost = "%d / %d / %d" % (d.get("no pose", 0), d.get("search failure", 0), d.get("scoring failure", 0))
+                print("| %s | %s | %s | %s%% | %s cm | %s deg | %.1f ms | %s |" %
+                      (name, what, label, r["valid"], r["pos"], r["rot"], r["ms"], lost))
+
+
+if __name__ == "__main__":
+    main()
