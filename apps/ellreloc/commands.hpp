@@ -51,7 +51,8 @@ void map(const MapArgs& a, const Console& console);
 
 struct RelocalizeArgs {
   std::string camera, map, detections, method = "ours", out, report, policy;
-  std::string reference;  ///< TUM poses to diagnose each frame against (search or scoring failure)
+  std::string reference;    ///< TUM poses to diagnose each frame against (search or scoring failure)
+  std::string envelope;     ///< TUM trajectory of the mapping keyframes: poses outside their envelope are dropped
   bool use_points = false;  ///< refine with the frames' keypoints matched to the map's points
   std::string points;       ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;

@@ -38,6 +38,10 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
                 "each frame's reference pose score under our cost and, for a pose off by >= 30 cm or 30 deg, "
                 "whether the search missed a better pose or the score preferred a wrong one")
       ->check(CLI::ExistingFile);
+  r->add_option("--envelope", a.envelope,
+                "TUM trajectory of the mapping keyframes: poses outside their heights and tilts (+-0.5 m, +-20 deg; "
+                "up from --map-up, else the keyframes' mean image-up) are never hypotheses")
+      ->check(CLI::ExistingFile);
   r->add_option("--points", a.points,
                 "refine with keypoints matched to the map's points: from this file (same frame "
                 "layout), or from the detections file when no file is given")
@@ -53,11 +57,13 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
                                   "for a camera at a fixed tilt, e.g. 0,-1,0 for a level camera")
                         ->expected(3)
                         ->delimiter(',');
-  auto* map_up = r->add_option("--map-up", a.map_up, "gravity prior: the up direction in the map frame, e.g. 0,0,1")
-                     ->expected(3)
-                     ->delimiter(',');
+  auto* map_up =
+      r->add_option(
+           "--map-up", a.map_up,
+           "the up direction in the map frame, e.g. 0,0,1: with --camera-up a gravity prior; the up of --envelope")
+          ->expected(3)
+          ->delimiter(',');
   camera_up->needs(map_up);
-  map_up->needs(camera_up);
   r->add_option("--gravity-sigma", a.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
       ->capture_default_str()
       ->needs(camera_up);
@@ -76,14 +82,11 @@ struct ReferenceScore {
 
 /// Observes and relocalizes every frame on `threads` worker threads; `observed` receives each
 /// frame's number of observations, `reference_scores` the score of each frame's reference pose.
-std::vector<RelocalizationResult> relocalizeFrames(const ObjectRelocalizer& relocalizer,
-                                                   const std::vector<DetectionFrame>& frames,
-                                                   const std::vector<std::vector<Keypoint>>& keypoints,
-                                                   const std::optional<GravityPrior>& gravity,
-                                                   const ObserveOptions& observe_options,
-                                                   const std::vector<std::optional<Pose>>& references, int threads,
-                                                   const Console& console, std::vector<int>* observed_out,
-                                                   std::vector<ReferenceScore>* reference_scores) {
+std::vector<RelocalizationResult> relocalizeFrames(
+    const ObjectRelocalizer& relocalizer, const std::vector<DetectionFrame>& frames,
+    const std::vector<std::vector<Keypoint>>& keypoints, const std::optional<GravityPrior>& gravity,
+    const ObserveOptions& observe_options, const std::vector<std::optional<Pose>>& references, int threads,
+    const Console& console, std::vector<int>* observed_out, std::vector<ReferenceScore>* reference_scores) {
   // Frames are independent: `threads` workers take the next frame until none is left (the
   // calling thread only shows progress). The first exception of any worker stops the others
   // and is rethrown here, so a worker's failure is reported like the calling thread's.
@@ -160,6 +163,14 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     throw Error("--method: unknown method '" + a.method + "' (ours, oa-slam)");
   }
   options.search.budget.max_time_ms = a.max_time_ms;
+  if (!a.envelope.empty()) {
+    std::vector<Pose> keyframes;
+    for (const io::StampedPose& p : io::readTumTrajectory(a.envelope)) keyframes.push_back(p.pose);
+    std::optional<Eigen::Vector3d> up;
+    if (a.map_up.size() == 3) up = Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]);
+    options.envelope = CameraEnvelope::fromKeyframes(keyframes, up);
+    if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
+  }
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "paper" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
@@ -240,9 +251,9 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   if (!a.reference.empty()) {  // a result: printed even when quiet
     std::printf("against %s:", a.reference.c_str());
     for (const auto& [diagnosis, count] : diagnoses) std::printf(" %s %d,", diagnosis.c_str(), count);
-    std::printf(" no reference pose %zu\n", frames.size() - static_cast<size_t>(std::count_if(
-                                                               references.begin(), references.end(),
-                                                               [](const auto& p) { return p.has_value(); })));
+    std::printf(" no reference pose %zu\n",
+                frames.size() - static_cast<size_t>(std::count_if(references.begin(), references.end(),
+                                                                  [](const auto& p) { return p.has_value(); })));
   }
   return static_cast<int>(poses.size());
 }

@@ -145,7 +145,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   // 2. Hypotheses into the pool: triplets, then pairs when the frame has few observations or
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
-  const GravityGate gate{gravity ? &*gravity : nullptr, options_.gravity.gate_deg};
+  const GravityGate gate{gravity ? &*gravity : nullptr, options_.gravity.gate_deg,
+                         options_.envelope ? &*options_.envelope : nullptr};
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer);
   HypothesisPool pool(options_.refinement.top_k);
   SearchOutcome search;

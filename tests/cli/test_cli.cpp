@@ -187,8 +187,8 @@ TEST(Cli, Fr3BoxesMapAndRelocalizationStayAboveTheMeasuredFloors) {
                 " --threads 2 --method " + (m == 0 ? "ours" : "oa-slam") + " --out " + dir.path("poses.txt"),
             dir);
     ASSERT_EQ(r.code, 0) << r.err;
-    r = run("evaluate --groundtruth " + d + "/groundtruth.txt --estimate " + dir.path("poses.txt") +
-                " --detections " + dir.path("query.json"),
+    r = run("evaluate --groundtruth " + d + "/groundtruth.txt --estimate " + dir.path("poses.txt") + " --detections " +
+                dir.path("query.json"),
             dir);
     ASSERT_EQ(r.code, 0) << r.err;
     const std::string last = r.out.substr(r.out.rfind("\n|", r.out.size() - 2) + 1);

@@ -1,15 +1,14 @@
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <sstream>
+
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 #include "ellreloc/io/map.hpp"
-
 #include "fixtures/data_dir.hpp"
 #include "fixtures/random_geometry.hpp"
 #include "fixtures/temp_dir.hpp"
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include <sstream>
 
 using namespace ellreloc;
 
@@ -25,7 +24,8 @@ TEST(MapIo, ReadsTheFr2MapAndItsDualQuadricsAgree) {
     const Ellipsoid& e = map.objects[i].ellipsoid;
     EXPECT_TRUE(e.isValid());
     Eigen::Matrix4d Q;
-    for (int k = 0; k < 16; ++k) Q(k / 4, k % 4) = j["objects"][i]["dual_quadric"][static_cast<size_t>(k)].get<double>();
+    for (int k = 0; k < 16; ++k)
+      Q(k / 4, k % 4) = j["objects"][i]["dual_quadric"][static_cast<size_t>(k)].get<double>();
     const auto from_q = Ellipsoid::fromDualQuadric(Q);
     ASSERT_TRUE(from_q.has_value());
     EXPECT_LT((from_q->center() - e.center()).norm(), 1e-5);
@@ -88,7 +88,8 @@ TEST(MapIo, ReadsOaSlamTextMaps) {
 }
 
 TEST(MapIo, MalformedMapsNameTheFileAndField) {
-  const std::string obj = R"({"id": 1, "category": 41, "center": [0, 0, 1], "axes": [0.1, 0.1, 0.2], "rotation": [[1,0,0],[0,1,0],[0,0,1]]})";
+  const std::string obj =
+      R"({"id": 1, "category": 41, "center": [0, 0, 1], "axes": [0.1, 0.1, 0.2], "rotation": [[1,0,0],[0,1,0],[0,0,1]]})";
   struct Case {
     std::string content, expected;
   };
@@ -98,15 +99,22 @@ TEST(MapIo, MalformedMapsNameTheFileAndField) {
       {"{\"ellreloc_map\": 1}", "objects: missing"},
       {"{\"objects\": {}}", "objects: expected an array"},
       {"{\"ellreloc_map\": 2, \"objects\": []}", "unsupported version"},
-      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].center: expected an array of 3"},
-      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,-1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].axes: semi-axes must be positive"},
-      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,0,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].axes"},
-      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,1,1], "rotation": [[2,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].rotation: not a rotation"},
-      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0]]}]})", "objects[0].rotation"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})",
+       "objects[0].center: expected an array of 3"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,-1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})",
+       "objects[0].axes: semi-axes must be positive"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,0,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})",
+       "objects[0].axes"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,1,1], "rotation": [[2,0,0],[0,1,0],[0,0,1]]}]})",
+       "objects[0].rotation: not a rotation"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0]]}]})",
+       "objects[0].rotation"},
       {R"({"objects": [{"id": "a", "category": 41}]})", "objects[0].id: expected an integer"},
       {R"({"objects": [{"id": 1, "category": 41.5}]})", "objects[0].category: expected an integer"},
-      {R"({"objects": [{"id": 1, "category": 41, "center": [0, "x", 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})", "objects[0].center[1]: expected a number"},
-      {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]})", "objects[0].dual_quadric: the dual quadric is singular"},
+      {R"({"objects": [{"id": 1, "category": 41, "center": [0, "x", 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})",
+       "objects[0].center[1]: expected a number"},
+      {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]})",
+       "objects[0].dual_quadric: the dual quadric is singular"},
       {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0]}]})", "objects[0].dual_quadric: expected 16"},
       {"{\"objects\": [" + obj + "], \"points\": [[1, 2]]}", "points[0]: expected an array of 3"},
       {"{\"objects\": [" + obj + ", 5]}", "objects[1]: expected an object"},
@@ -158,7 +166,8 @@ TEST(MapIo, UnusableObjectsAreLeftOutWithAWarningEach) {
   }
   // OA-SLAM text: a singular dual quadric on line 2, a sphere of radius 0.5 on line 3.
   const std::string text = dir.path("map.txt");
-  io::writeFileAtomically(text, "7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n8 41 0.25 0 0 0 0 0.25 0 0 0 0 0.25 0 0 0 0 -1\n");
+  io::writeFileAtomically(text,
+                          "7 41 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n8 41 0.25 0 0 0 0 0.25 0 0 0 0 0.25 0 0 0 0 -1\n");
   warnings.clear();
   const ObjectMap oa = io::readMap(text, &warnings);
   ASSERT_EQ(oa.objects.size(), 1u);

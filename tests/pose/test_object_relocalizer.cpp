@@ -459,3 +459,48 @@ TEST(ObjectRelocalizer, LeavesOutDegenerateMapObjects) {
     EXPECT_NE(m.object, s.object_of[1]);
   }
 }
+
+// The envelope of the mapping keyframes: heights and tilts widened by the margins; the up
+// direction defaults to the keyframes' mean image-up.
+TEST(CameraEnvelope, FromKeyframesAndAdmits) {
+  const Eigen::Vector3d target(0.0, 0.0, 0.8);
+  const std::vector<Pose> keyframes = {Pose::lookAt({2.0, 0.0, 1.2}, target), Pose::lookAt({0.0, 2.0, 1.6}, target),
+                                       Pose::lookAt({-2.0, 0.0, 1.4}, target)};
+  const auto e = CameraEnvelope::fromKeyframes(keyframes, Eigen::Vector3d::UnitZ(), 0.5, 20.0);
+  ASSERT_TRUE(e);
+  EXPECT_NEAR(e->min_height, 0.7, 1e-9);
+  EXPECT_NEAR(e->max_height, 2.1, 1e-9);
+  const double steepest = std::atan2(0.8, 2.0) * 180.0 / M_PI;  // camera at 1.6 m looking 0.8 m down over 2 m
+  EXPECT_NEAR(e->max_tilt_deg, steepest + 20.0, 1e-6);
+  EXPECT_TRUE(e->admits(Pose::lookAt({1.0, 1.0, 1.3}, target)));
+  EXPECT_FALSE(e->admits(Pose::lookAt({1.0, 1.0, -0.5}, target)));  // under the floor
+  EXPECT_FALSE(e->admits(Pose::lookAt({0.1, 0.0, 2.0}, target)));   // looking straight down
+  EXPECT_TRUE(e->isValid());
+  EXPECT_FALSE(CameraEnvelope::fromKeyframes({keyframes[0]}));
+  const auto estimated = CameraEnvelope::fromKeyframes(keyframes);  // up from the cameras
+  ASSERT_TRUE(estimated);
+  EXPECT_GT(estimated->up.z(), 0.9);
+}
+
+// Relocalization never returns a pose outside the envelope: with the true pose inside it, the
+// pose is found; with an envelope that excludes it, the true pose is not returned.
+TEST(ObjectRelocalizer, EnvelopeGatesPoses) {
+  std::mt19937 rng(12);
+  const Synthetic s = makeSceneSeeing(rng, 6, 12, 6);
+  RelocalizerOptions options;
+  options.envelope = CameraEnvelope::fromKeyframes({s.truth, s.truth}, Eigen::Vector3d::UnitZ(), 0.2, 5.0);
+  ASSERT_TRUE(options.envelope);
+  const RelocalizationResult inside =
+      ObjectRelocalizer(s.map, test::testIntrinsics(), options).relocalize(s.observations);
+  ASSERT_EQ(inside.status, RelocalizationStatus::Success) << inside.reason;
+  EXPECT_LT(positionError(inside.pose, s.truth), 0.05);
+  options.envelope->min_height += 1.0;  // the true camera is now 0.8 m below the envelope
+  options.envelope->max_height += 1.0;
+  const RelocalizationResult outside =
+      ObjectRelocalizer(s.map, test::testIntrinsics(), options).relocalize(s.observations);
+  if (outside.status == RelocalizationStatus::Success) EXPECT_GT(positionError(outside.pose, s.truth), 0.3);
+  options.envelope->min_height = 5.0;  // empty range: an invalid option
+  options.envelope->max_height = 4.0;
+  EXPECT_EQ(ObjectRelocalizer(s.map, test::testIntrinsics(), options).relocalize(s.observations).status,
+            RelocalizationStatus::InvalidInput);
+}

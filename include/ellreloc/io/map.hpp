@@ -3,10 +3,10 @@
 /// Object maps: the JSON map of FORMATS.md (objects as centre/axes/rotation or as a dual
 /// quadric) and OA-SLAM's text maps (`track_id category_id` + 16 column-major Q* entries).
 
-#include "ellreloc/core/object_map.hpp"
-
 #include <string>
 #include <vector>
+
+#include "ellreloc/core/object_map.hpp"
 
 namespace ellreloc::io {
 

@@ -10,9 +10,11 @@
 /// validate() names the first field out of range; the relocalizer then answers InvalidInput.
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "ellreloc/core/ransac.hpp"
+#include "ellreloc/pose/camera_envelope.hpp"
 #include "ellreloc/pose/few_object_poses.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
@@ -111,6 +113,9 @@ struct RelocalizerOptions {
   FewObjectSearchOptions few_objects;
   GravityOptions gravity;
   RefinementStageOptions refinement;
+  /// Where the camera can be (camera_envelope.hpp, e.g. from the mapping keyframes): poses
+  /// outside are never hypotheses. None: anywhere.
+  std::optional<CameraEnvelope> envelope;
 
   /// OA-SLAM's relocalization as a baseline: every detection triplet against every object
   /// triplet of equal categories, P3P on box centres, box-IoU scoring, no refinement. Give it
@@ -167,6 +172,8 @@ struct RelocalizerOptions {
       return "refinement.refiner has a non-positive or non-finite scale or weight";
     if (r.max_iterations < 0 || !(r.function_tolerance >= 0))
       return "refinement.refiner has a negative tolerance or count";
+    if (envelope && !envelope->isValid())
+      return "envelope has a non-unit or non-finite up, or an empty or non-finite range";
     return "";
   }
 };

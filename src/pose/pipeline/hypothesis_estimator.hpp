@@ -15,12 +15,15 @@
 
 namespace ellreloc::pipeline {
 
-/// Drops poses that tilt the camera more than max(gate_deg, 5 sigma) away from a gravity prior.
+/// Drops poses that tilt the camera more than max(gate_deg, 5 sigma) away from a gravity prior,
+/// and poses outside the camera envelope.
 struct GravityGate {
   const GravityPrior* prior = nullptr;  // none: every pose passes
   double gate_deg = 15.0;
+  const CameraEnvelope* envelope = nullptr;  // none: anywhere
   bool admits(const Pose& pose) const {
-    return !prior || prior->errorDeg(pose) <= std::max(gate_deg, 5.0 * prior->sigma_deg);
+    return (!prior || prior->errorDeg(pose) <= std::max(gate_deg, 5.0 * prior->sigma_deg)) &&
+           (!envelope || envelope->admits(pose));
   }
 };
 

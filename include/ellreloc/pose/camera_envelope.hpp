@@ -1,0 +1,79 @@
+#pragma once
+/// \file camera_envelope.hpp
+/// Where a camera can plausibly be: the heights and tilts at which the map's keyframes were
+/// taken, widened by margins. A hand-held or robot camera that mapped a room from 1.2-1.7 m,
+/// looking 20-45 degrees down, does not come back upside down or under the floor, yet two boxes
+/// matched to two look-alike objects can be explained by such a pose as well as by the true
+/// one. Poses outside the envelope are never hypotheses (RelocalizerOptions::envelope).
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "ellreloc/core/pose.hpp"
+
+namespace ellreloc {
+
+struct CameraEnvelope {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< world frame, unit length
+  double min_height = -1e9, max_height = 1e9;     ///< camera centre along `up`, metres
+  /// Angle between the camera's image-up direction (-y) and `up`: 0 for a level camera, 90 for
+  /// one looking straight down or up.
+  double min_tilt_deg = 0.0, max_tilt_deg = 180.0;
+
+  bool isValid() const {
+    return up.allFinite() && std::abs(up.norm() - 1.0) < 1e-6 && std::isfinite(min_height) &&
+           std::isfinite(max_height) && min_height <= max_height && std::isfinite(min_tilt_deg) &&
+           std::isfinite(max_tilt_deg) && min_tilt_deg <= max_tilt_deg;
+  }
+
+  static double heightOf(const Pose& pose, const Eigen::Vector3d& up) { return up.dot(pose.center()); }
+  static double tiltDegOf(const Pose& pose, const Eigen::Vector3d& up) {
+    const Eigen::Vector3d image_up = -pose.rotation().transpose().col(1);  // camera -y in the world
+    return std::acos(std::clamp(image_up.dot(up), -1.0, 1.0)) * 180.0 / M_PI;
+  }
+
+  /// The world->camera pose lies within the envelope.
+  bool admits(const Pose& pose) const {
+    const double h = heightOf(pose, up), t = tiltDegOf(pose, up);
+    return h >= min_height && h <= max_height && t >= min_tilt_deg && t <= max_tilt_deg;
+  }
+
+  /// The envelope of mapping keyframes (world->camera poses): their range of heights widened by
+  /// `height_margin` metres and of tilts by `tilt_margin_deg`. `up`: the world's up when known;
+  /// nullopt takes the mean image-up direction of the keyframes (hand-held and robot cameras
+  /// keep their roll small), so heights and tilts are measured consistently, if not from true
+  /// vertical. nullopt for fewer than 2 valid poses.
+  static std::optional<CameraEnvelope> fromKeyframes(const std::vector<Pose>& keyframes,
+                                                     std::optional<Eigen::Vector3d> up = std::nullopt,
+                                                     double height_margin = 0.5, double tilt_margin_deg = 20.0) {
+    std::vector<Pose> valid;
+    for (const Pose& p : keyframes)
+      if (p.isValid()) valid.push_back(p);
+    if (valid.size() < 2) return std::nullopt;
+    if (!up) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (const Pose& p : valid) sum -= p.rotation().transpose().col(1);
+      if (!(sum.norm() > 1e-9)) return std::nullopt;
+      up = sum;
+    }
+    if (!up->allFinite() || !(up->norm() > 1e-9)) return std::nullopt;
+    CameraEnvelope e;
+    e.up = up->normalized();
+    e.min_height = e.min_tilt_deg = 1e300;
+    e.max_height = e.max_tilt_deg = -1e300;
+    for (const Pose& p : valid) {
+      const double h = heightOf(p, e.up), t = tiltDegOf(p, e.up);
+      e.min_height = std::min(e.min_height, h), e.max_height = std::max(e.max_height, h);
+      e.min_tilt_deg = std::min(e.min_tilt_deg, t), e.max_tilt_deg = std::max(e.max_tilt_deg, t);
+    }
+    e.min_height -= height_margin, e.max_height += height_margin;
+    e.min_tilt_deg = std::max(0.0, e.min_tilt_deg - tilt_margin_deg);
+    e.max_tilt_deg = std::min(180.0, e.max_tilt_deg + tilt_margin_deg);
+    return e;
+  }
+};
+
+}  // namespace ellreloc
