@@ -24,6 +24,16 @@ struct Console {
   void endProgress() const;
 };
 
+/// A path given to an option, for messages.
+struct NamedPath {
+  std::string option, path;
+};
+
+/// Before any work: refuses (Error) an output that is the same file as an input or another
+/// output (same device and inode, or the same resolved path when it does not exist yet), or
+/// that exists and is not a regular file. Empty paths are skipped.
+void checkPaths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
+
 struct SimulateArgs {
   std::string preset = "office", noise = "realistic", out;
   unsigned long seed = 1;

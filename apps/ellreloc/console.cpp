@@ -1,6 +1,8 @@
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "commands.hpp"
@@ -16,6 +18,37 @@ void Console::progress(const char* what, size_t done, size_t total) const {
 
 void Console::endProgress() const {
   if (!quiet && isatty(STDERR_FILENO)) std::fprintf(stderr, "\r%60s\r", "");
+}
+
+namespace {
+
+/// What identifies a path's file: device and inode when it exists, else its resolved path.
+std::string fileIdentity(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  std::error_code ec;
+  const std::filesystem::path resolved = std::filesystem::weakly_canonical(path, ec);
+  return "path " + (ec ? path : resolved.string());
+}
+
+}  // namespace
+
+void checkPaths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
+  std::vector<std::pair<std::string, const NamedPath*>> seen;
+  for (const NamedPath& in : inputs)
+    if (!in.path.empty()) seen.emplace_back(fileIdentity(in.path), &in);
+  for (const NamedPath& out : outputs) {
+    if (out.path.empty()) continue;
+    struct stat st {};
+    if (::stat(out.path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      throw Error(out.option + ": '" + out.path + "' exists and is not a regular file (a directory, device or FIFO)");
+    const std::string id = fileIdentity(out.path);
+    for (const auto& [other_id, other] : seen)
+      if (other_id == id)
+        throw Error(out.option + ": '" + out.path + "' is the same file as " + other->option +
+                    "; refusing to overwrite it");
+    seen.emplace_back(id, &out);
+  }
 }
 
 }  // namespace ellreloc::cli

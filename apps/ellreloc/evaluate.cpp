@@ -86,6 +86,8 @@ void writePlot(const std::string& path, const std::vector<io::StampedPose>& gt,
 }  // namespace
 
 RelocalizationSummary evaluate(const EvaluateArgs& a) {
+  checkPaths({{"--plot", a.plot}},
+             {{"--groundtruth", a.groundtruth}, {"--estimate", a.estimate}, {"--detections", a.detections}});
   const std::vector<io::StampedPose> gt = io::readTumTrajectory(a.groundtruth);
   // An estimate without poses is a run that relocalized nothing: 0% valid, not an error.
   const std::vector<io::StampedPose> est = io::readTumTrajectory(a.estimate, /*allow_empty=*/true);

@@ -77,6 +77,11 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
 }
 
 void map(const MapArgs& a, const Console& console) {
+  checkPaths({{"--out", a.out}}, {{"--camera", a.camera},
+                                  {"--associations", a.associations},
+                                  {"--trajectory", a.trajectory},
+                                  {"--detections", a.detections},
+                                  {"--holdout", a.holdout}});
   const Intrinsics K = io::readCamera(a.camera);
   MapperOptions options;
   if (!parseMappingMode(a.mode, &options.mode)) throw Error("--mode: unknown mode '" + a.mode + "' (voxel, boxes)");

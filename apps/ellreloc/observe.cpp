@@ -28,6 +28,7 @@ ObservationPolicy parsePolicy(const std::string& name) {
 }
 
 void observe(const ObserveArgs& a, const Console& console) {
+  checkPaths({{"--out", a.out}}, {{"--camera", a.camera}, {"--detections", a.detections}});
   const Intrinsics K = io::readCamera(a.camera);
   std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   ObserveOptions options;

@@ -149,6 +149,12 @@ std::string diagnose(const RelocalizationResult& result, const ReferenceScore& r
 }  // namespace
 
 int relocalize(const RelocalizeArgs& a, const Console& console) {
+  checkPaths({{"--out", a.out}, {"--report", a.report}}, {{"--camera", a.camera},
+                                                          {"--map", a.map},
+                                                          {"--detections", a.detections},
+                                                          {"--points", a.points},
+                                                          {"--reference", a.reference},
+                                                          {"--envelope", a.envelope}});
   const Intrinsics K = io::readCamera(a.camera);
   std::vector<std::string> left_out;
   const ObjectMap object_map = io::readMap(a.map, &left_out);

@@ -1,6 +1,7 @@
 #include "ellreloc/io/rgbd.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -41,10 +42,25 @@ std::vector<Association> readAssociations(const std::string& path) {
 }
 
 DepthImage readDepthPng(const std::string& path, double units_per_metre) {
-  readTextFile(path);  // names the file when it is missing or unreadable
+  const std::string bytes = readTextFile(path);  // names the file when it is missing or unreadable
+  // The size from the PNG header (IHDR) before decoding: a small file can declare a huge image.
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() < 24 || std::memcmp(bytes.data(), kSignature, 8) != 0 || bytes.compare(12, 4, "IHDR") != 0)
+    throw Error(path + ": not a PNG image");
+  const auto be32 = [&](size_t at) {
+    return (static_cast<uint32_t>(static_cast<unsigned char>(bytes[at])) << 24) |
+           (static_cast<uint32_t>(static_cast<unsigned char>(bytes[at + 1])) << 16) |
+           (static_cast<uint32_t>(static_cast<unsigned char>(bytes[at + 2])) << 8) |
+           static_cast<uint32_t>(static_cast<unsigned char>(bytes[at + 3]));
+  };
+  const uint64_t width = be32(16), height = be32(20);
+  if (width == 0 || height == 0 || width * height > kMaxDepthPixels)
+    throw Error(path + ": declares a " + std::to_string(width) + "x" + std::to_string(height) +
+                " image; depth images are limited to " + std::to_string(kMaxDepthPixels) + " pixels");
   cv::Mat img;
   try {
-    img = cv::imread(path, cv::IMREAD_UNCHANGED);
+    img = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
+                       cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     throw Error(path + ": cannot decode image (" + e.msg + ")");
   }

@@ -2,6 +2,7 @@
 // the real fr2_desk regression guard, and the bad-input table (exit code 2, one line, no file).
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -215,6 +216,49 @@ TEST(Cli, DegenerateMapObjectsAreReportedAndLeftOut) {
             std::string::npos)
       << r.err;
   EXPECT_EQ(r.err.find("object 5"), std::string::npos) << r.err;
+}
+
+// An output that is an input (by name, through a link, or another output) is refused before any
+// work and the input is left as it was; devices and FIFOs are refused as inputs and outputs.
+TEST(Cli, OutputsNeverClobberInputsAndOnlyRegularFilesAreRead) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr2_desk");
+  const std::string detections = dir.path("detections.json"), map = dir.path("map.json");
+  fs::copy_file(d + "/keyframes.detections.json", detections);
+  fs::copy_file(d + "/map.json", map);
+  fs::create_hard_link(map, dir.path("map_link.json"));
+  fs::create_symlink(detections, dir.path("detections_symlink.json"));
+  fs::create_directory(dir.path("folder"));
+  ASSERT_EQ(::mkfifo(dir.path("fifo").c_str(), 0600), 0);
+  const std::string before_detections = readFile(detections), before_map = readFile(map);
+  const std::string reloc = "relocalize --camera " + d + "/camera.yaml ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--out is --detections", reloc + "--map " + map + " --detections " + detections + " --out " + detections},
+      {"--out is --map by a hard link",
+       reloc + "--map " + map + " --detections " + detections + " --out " + dir.path("map_link.json")},
+      {"--report is --detections by a symlink", reloc + "--map " + map + " --detections " + detections + " --out " +
+                                                    dir.path("poses.txt") + " --report " +
+                                                    dir.path("detections_symlink.json")},
+      {"--report is --out", reloc + "--map " + map + " --detections " + detections + " --out " + dir.path("p.txt") +
+                                " --report " + dir.path("./p.txt")},
+      {"--out is a directory", reloc + "--map " + map + " --detections " + detections + " --out " + dir.path("folder")},
+      {"observe --out is --detections",
+       "observe --camera " + d + "/camera.yaml --detections " + detections + " --out " + detections},
+      {"--detections is a device", reloc + "--map " + map + " --detections /dev/zero --out " + dir.path("x.txt")},
+      {"--map is a FIFO without a writer",
+       reloc + "--map " + dir.path("fifo") + " --detections " + detections + " --out " + dir.path("x.txt")},
+  };
+  for (const auto& [name, args] : cases) {
+    const CliRun r = run(args, dir);
+    EXPECT_EQ(r.code, 2) << name << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << name << ": " << r.err;
+  }
+  EXPECT_EQ(readFile(detections), before_detections);
+  EXPECT_EQ(readFile(map), before_map);
+  EXPECT_FALSE(fs::exists(dir.path("poses.txt")));
+  EXPECT_FALSE(fs::exists(dir.path("p.txt")));
+  EXPECT_FALSE(fs::exists(dir.path("x.txt")));
+  EXPECT_TRUE(fs::is_symlink(dir.path("detections_symlink.json")));
 }
 
 TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {

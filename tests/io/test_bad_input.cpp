@@ -126,3 +126,47 @@ TEST(BadInput, FailedWritesLeaveNoFile) {
 
 }  // namespace
 }  // namespace ellreloc
+
+namespace ellreloc {
+namespace {
+
+// Inputs must be regular files within the size limit; a PNG's declared size is checked before
+// decoding; a written symlink keeps pointing at its (replaced) target.
+TEST(BadInput, InputsAreRegularFilesWithinLimitsAndSymlinkOutputsStayLinks) {
+  test::TempDir dir;
+  EXPECT_THROW(io::readTextFile("/dev/zero"), Error);
+  io::writeFileAtomically(dir.path("big.txt"), std::string(2048, 'x'));
+  ::setenv("ELLRELOC_MAX_INPUT_BYTES", "1024", 1);
+  try {
+    io::readTextFile(dir.path("big.txt"));
+    ADD_FAILURE() << "a file above the limit was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("above the input limit of 1024"), std::string::npos) << e.what();
+  }
+  ::unsetenv("ELLRELOC_MAX_INPUT_BYTES");
+  EXPECT_EQ(io::readTextFile(dir.path("big.txt")).size(), 2048u);
+
+  // A PNG header declaring 20000 x 20000 pixels, and nothing else.
+  std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + std::string("\0\0\0\x0dIHDR", 8);
+  for (uint32_t v : {20000u, 20000u})
+    for (int shift : {24, 16, 8, 0}) png += static_cast<char>((v >> shift) & 0xff);
+  png += std::string("\x10\0\0\0\0\0\0\0\0", 9);
+  io::writeFileAtomically(dir.path("huge.png"), png);
+  try {
+    io::readDepthPng(dir.path("huge.png"));
+    ADD_FAILURE() << "a 20000 x 20000 depth PNG was decoded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("declares a 20000x20000 image"), std::string::npos) << e.what();
+  }
+
+  io::writeFileAtomically(dir.path("target.txt"), "old");
+  std::filesystem::create_symlink(dir.path("target.txt"), dir.path("link.txt"));
+  io::writeFileAtomically(dir.path("link.txt"), "new");
+  EXPECT_TRUE(std::filesystem::is_symlink(dir.path("link.txt")));
+  EXPECT_EQ(io::readTextFile(dir.path("target.txt")), "new");
+  std::filesystem::create_directory(dir.path("folder"));
+  EXPECT_THROW(io::writeFileAtomically(dir.path("folder"), "x"), Error);
+}
+
+}  // namespace
+}  // namespace ellreloc

@@ -2,16 +2,25 @@
 /// \file files.hpp
 /// Whole-file reading and atomic writing, shared by every reader and writer.
 
+#include <cstddef>
 #include <sstream>
 #include <string>
 
 namespace ellreloc::io {
 
-/// The file's bytes. Throws ellreloc::Error("PATH: cannot open ...") when it cannot be read.
+/// Inputs larger than this are refused before reading: 1 GiB, or the environment variable
+/// ELLRELOC_MAX_INPUT_BYTES.
+size_t maxInputBytes();
+
+/// The file's bytes. Throws ellreloc::Error("PATH: ...") when it cannot be read, is not a
+/// regular file (a device such as /dev/zero, a FIFO: refused at once, never read) or is larger
+/// than maxInputBytes().
 std::string readTextFile(const std::string& path);
 
 /// Writes to a temporary file beside `path` and renames it into place, so a failure never
-/// leaves a half-written file. Throws ellreloc::Error naming the path on failure.
+/// leaves a half-written file. A symbolic link is followed; an existing path that is not a
+/// regular file (a directory, device or FIFO) is refused. Throws ellreloc::Error naming the
+/// path on failure.
 void writeFileAtomically(const std::string& path, const std::string& content);
 
 /// Calls f(line_number, line) for each line of a line-oriented text format (TUM trajectories,

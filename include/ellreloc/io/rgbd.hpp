@@ -3,6 +3,7 @@
 /// TUM RGB-D sequences: association files (`t_rgb rgb/X.png t_depth depth/Y.png`) and 16-bit
 /// depth PNGs with 5000 units per metre (0 = no reading).
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ constexpr double kTumDepthUnitsPerMetre = 5000.0;
 
 /// Reads a 16-bit single-channel depth PNG (units_per_metre units = 1 m). Throws
 /// ellreloc::Error when the file is missing, not a PNG, or not 16-bit single-channel.
+/// Depth images declaring more pixels than this in their header are refused before decoding
+/// (a few hundred bytes of PNG can declare gigabytes); 64 Mpx is 8x a 4K depth map.
+constexpr uint64_t kMaxDepthPixels = uint64_t{1} << 26;
+
 DepthImage readDepthPng(const std::string& path, double units_per_metre = kTumDepthUnitsPerMetre);
 
 /// Writes a 16-bit depth PNG (rounded; depths beyond 65535 units or invalid become 0), atomically.
