@@ -146,6 +146,50 @@ std::string diagnose(const RelocalizationResult& result, const ReferenceScore& r
   return best < result.cost ? "search failure" : "scoring failure";
 }
 
+/// The options of --method, --max-time-ms and --envelope; `policy` gets the method's default.
+RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* policy_out) {
+  RelocalizerOptions options;
+  if (a.method == "oa-slam") {
+    options = RelocalizerOptions::oaSlam();
+    if (policy_out->empty()) *policy_out = "bbox";
+  } else if (a.method != "ours") {
+    throw Error("--method: unknown method '" + a.method + "' (ours, oa-slam)");
+  }
+  options.search.budget.max_time_ms = a.max_time_ms;
+  if (!a.envelope.empty()) {
+    std::vector<Pose> keyframes;
+    for (const io::StampedPose& p : io::readTumTrajectory(a.envelope)) keyframes.push_back(p.pose);
+    std::optional<Eigen::Vector3d> up;
+    if (a.map_up.size() == 3) up = Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]);
+    options.envelope = CameraEnvelope::fromKeyframes(keyframes, up);
+    if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
+  }
+  return options;
+}
+
+/// One frame's entry of the --report JSON (with its diagnosis against a reference pose).
+nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResult& r, int observed,
+                           const ObjectMap& map, const Pose* reference, const ReferenceScore& ref,
+                           const std::string& diagnosis) {
+  nlohmann::json j = {{"file_name", frame.file_name},   {"status", toString(r.status)}, {"reason", r.reason},
+                      {"observations", observed},       {"inliers", r.inliers.size()},  {"score", r.cost},
+                      {"mean_overlap", r.mean_overlap}, {"hypotheses", r.hypotheses},   {"time_ms", r.time_ms}};
+  nlohmann::json matches = nlohmann::json::array();
+  for (const ObjectCorrespondence& c : r.inliers)
+    matches.push_back({{"observation", c.observation},
+                       {"object_id", map.objects[static_cast<size_t>(c.object)].id},
+                       {"overlap", c.overlap}});
+  j["matches"] = matches;
+  if (reference)
+    j["reference"] = {{"score", ref.given.cost},
+                      {"inliers", ref.given.inliers.size()},
+                      {"refined_score", ref.refined.cost},
+                      {"refined_inliers", ref.refined.inliers.size()},
+                      {"refined_moved_cm", poseError(ref.refined.pose, *reference).position_cm},
+                      {"diagnosis", diagnosis}};
+  return j;
+}
+
 }  // namespace
 
 int relocalize(const RelocalizeArgs& a, const Console& console) {
@@ -160,23 +204,8 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const ObjectMap object_map = io::readMap(a.map, &left_out);
   for (const std::string& w : left_out) std::fprintf(stderr, "warning: %s\n", w.c_str());
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
-  RelocalizerOptions options;
   std::string policy = a.policy;
-  if (a.method == "oa-slam") {
-    options = RelocalizerOptions::oaSlam();
-    if (policy.empty()) policy = "bbox";
-  } else if (a.method != "ours") {
-    throw Error("--method: unknown method '" + a.method + "' (ours, oa-slam)");
-  }
-  options.search.budget.max_time_ms = a.max_time_ms;
-  if (!a.envelope.empty()) {
-    std::vector<Pose> keyframes;
-    for (const io::StampedPose& p : io::readTumTrajectory(a.envelope)) keyframes.push_back(p.pose);
-    std::optional<Eigen::Vector3d> up;
-    if (a.map_up.size() == 3) up = Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]);
-    options.envelope = CameraEnvelope::fromKeyframes(keyframes, up);
-    if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
-  }
+  const RelocalizerOptions options = relocalizerOptions(a, &policy);
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "paper" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
@@ -221,26 +250,11 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   for (size_t i = 0; i < frames.size(); ++i) {
     const RelocalizationResult& r = results[i];
     times.push_back(r.time_ms);
-    nlohmann::json j = {{"file_name", frames[i].file_name}, {"status", toString(r.status)}, {"reason", r.reason},
-                        {"observations", observed[i]},      {"inliers", r.inliers.size()},  {"score", r.cost},
-                        {"mean_overlap", r.mean_overlap},   {"hypotheses", r.hypotheses},   {"time_ms", r.time_ms}};
-    nlohmann::json matches = nlohmann::json::array();
-    for (const ObjectCorrespondence& c : r.inliers)
-      matches.push_back({{"observation", c.observation},
-                         {"object_id", object_map.objects[static_cast<size_t>(c.object)].id},
-                         {"overlap", c.overlap}});
-    j["matches"] = matches;
-    if (references[i]) {
-      const std::string diagnosis = diagnose(r, reference_scores[i], *references[i]);
-      ++diagnoses[diagnosis];
-      const ReferenceScore& ref = reference_scores[i];
-      j["reference"] = {{"score", ref.given.cost},
-                        {"inliers", ref.given.inliers.size()},
-                        {"refined_score", ref.refined.cost},
-                        {"refined_inliers", ref.refined.inliers.size()},
-                        {"refined_moved_cm", poseError(ref.refined.pose, *references[i]).position_cm},
-                        {"diagnosis", diagnosis}};
-    }
+    const Pose* reference = references[i] ? &*references[i] : nullptr;
+    const std::string diagnosis = reference ? diagnose(r, reference_scores[i], *reference) : "";
+    if (reference) ++diagnoses[diagnosis];
+    const nlohmann::json j =
+        frameReport(frames[i], r, observed[i], object_map, reference, reference_scores[i], diagnosis);
     report.push_back(j);
     if (r.status != RelocalizationStatus::Success) continue;
     const std::optional<double> t = frames[i].timestamp();

@@ -78,6 +78,74 @@ std::vector<BoxView> spread(const std::vector<BoxView>& views, size_t n) {
   return out;
 }
 
+/// The Ceres fit of the 9-DoF ellipsoid (or 7 when upright) from `centre` and a sphere of
+/// `radius`, with the size prior; false (and `out` says why) when it cannot be made.
+bool fitEllipsoid(const Intrinsics& K, const std::vector<BoxView>& views, const BoxEllipsoidOptions& options,
+                  const BoxSizePrior& prior, const Eigen::Vector3d& centre, double radius, BoxEllipsoidResult* out) {
+  // Semi-axis bounds from the prior; the initial radius within them.
+  Eigen::Vector3d typical = prior.typical_semi_axes;
+  std::sort(typical.data(), typical.data() + 3);
+  double lo = 1e-3, hi = 1e3;
+  if (options.use_size_prior) {
+    lo = std::max(prior.min_axis, typical(0) / prior.range_factor);
+    hi = std::max(lo * 2.0, std::min(prior.max_axis, typical(2) * prior.range_factor));
+  }
+  double c[3] = {centre.x(), centre.y(), centre.z()};
+  const double log_r = std::log(std::clamp(radius, lo, hi));
+  double s[3] = {log_r, log_r, log_r};
+  double w[3] = {0.0, 0.0, 0.0};
+  const Eigen::Matrix3d base = options.up ? groundBasis(*options.up) : Eigen::Matrix3d::Identity();
+
+  ceres::Problem problem;
+  for (const BoxView& v : views) {
+    const auto e = Ellipse::inscribedInBox(v.box);
+    if (!e) continue;
+    auto* cost = new BoxW2Cost{projectionMatrix(K, v.pose), v.pose, *e, std::sqrt(e->axes().prod()), base};
+    double probe[6];
+    const double* params[3] = {c, s, w};
+    if (!(*cost)(params[0], params[1], params[2], probe)) {  // a camera inside the start sphere
+      delete cost;
+      continue;
+    }
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BoxW2Cost, 6, 3, 3, 3>(cost), new ceres::HuberLoss(0.5), c,
+                             s, w);
+  }
+  if (problem.NumResidualBlocks() < static_cast<int>(std::max<size_t>(options.min_views, 2))) {
+    out->status = BoxEllipsoidStatus::TooFewViews;
+    out->reason = std::to_string(problem.NumResidualBlocks()) + " views see the object from outside";
+    return false;
+  }
+  if (options.use_size_prior) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SizePriorCost, 3, 3>(
+                                 new SizePriorCost{typical.array().log().matrix(), prior.sigma_log}),
+                             nullptr, s);
+    for (int k = 0; k < 3; ++k) {
+      problem.SetParameterLowerBound(s, k, std::log(lo));
+      problem.SetParameterUpperBound(s, k, std::log(hi));
+    }
+  }
+  if (options.up) problem.SetManifold(w, new ceres::SubsetManifold(3, {0, 1}));  // yaw about up only
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+
+  double R_data[9];
+  ceres::AngleAxisToRotationMatrix(w, ceres::ColumnMajorAdapter3x3(R_data));
+  const Eigen::Matrix3d R = nearestRotation(base * Eigen::Map<const Eigen::Matrix3d>(R_data));
+  out->ellipsoid =
+      Ellipsoid(Eigen::Vector3d(c[0], c[1], c[2]), Eigen::Vector3d(std::exp(s[0]), std::exp(s[1]), std::exp(s[2])), R);
+  if (!out->ellipsoid.isValid()) {
+    out->status = BoxEllipsoidStatus::InvalidInput;
+    out->reason = "refinement diverged";
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 const char* toString(BoxEllipsoidStatus status) {
@@ -164,67 +232,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
     }
     radii.push_back(0.25 * (v.box.width() / K.fx + v.box.height() / K.fy) * z);
   }
-  // Semi-axis bounds from the prior; the initial radius within them.
-  Eigen::Vector3d typical = prior.typical_semi_axes;
-  std::sort(typical.data(), typical.data() + 3);
-  double lo = 1e-3, hi = 1e3;
-  if (options.use_size_prior) {
-    lo = std::max(prior.min_axis, typical(0) / prior.range_factor);
-    hi = std::max(lo * 2.0, std::min(prior.max_axis, typical(2) * prior.range_factor));
-  }
-  double c[3] = {centre->x(), centre->y(), centre->z()};
-  const double log_r = std::log(std::clamp(median(radii), lo, hi));
-  double s[3] = {log_r, log_r, log_r};
-  double w[3] = {0.0, 0.0, 0.0};
-  const Eigen::Matrix3d base = options.up ? groundBasis(*options.up) : Eigen::Matrix3d::Identity();
-
-  ceres::Problem problem;
-  for (const BoxView& v : views) {
-    const auto e = Ellipse::inscribedInBox(v.box);
-    if (!e) continue;
-    auto* cost = new BoxW2Cost{projectionMatrix(K, v.pose), v.pose, *e, std::sqrt(e->axes().prod()), base};
-    double probe[6];
-    const double* params[3] = {c, s, w};
-    if (!(*cost)(params[0], params[1], params[2], probe)) {  // a camera inside the start sphere
-      delete cost;
-      continue;
-    }
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BoxW2Cost, 6, 3, 3, 3>(cost), new ceres::HuberLoss(0.5), c,
-                             s, w);
-  }
-  if (problem.NumResidualBlocks() < static_cast<int>(std::max<size_t>(options.min_views, 2))) {
-    out.status = BoxEllipsoidStatus::TooFewViews;
-    out.reason = std::to_string(problem.NumResidualBlocks()) + " views see the object from outside";
-    return out;
-  }
-  if (options.use_size_prior) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SizePriorCost, 3, 3>(
-                                 new SizePriorCost{typical.array().log().matrix(), prior.sigma_log}),
-                             nullptr, s);
-    for (int k = 0; k < 3; ++k) {
-      problem.SetParameterLowerBound(s, k, std::log(lo));
-      problem.SetParameterUpperBound(s, k, std::log(hi));
-    }
-  }
-  if (options.up) problem.SetManifold(w, new ceres::SubsetManifold(3, {0, 1}));  // yaw about up only
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options.max_iterations;
-  solver.num_threads = 1;
-  solver.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
-
-  double R_data[9];
-  ceres::AngleAxisToRotationMatrix(w, ceres::ColumnMajorAdapter3x3(R_data));
-  const Eigen::Matrix3d R = nearestRotation(base * Eigen::Map<const Eigen::Matrix3d>(R_data));
-  out.ellipsoid =
-      Ellipsoid(Eigen::Vector3d(c[0], c[1], c[2]), Eigen::Vector3d(std::exp(s[0]), std::exp(s[1]), std::exp(s[2])), R);
-  if (!out.ellipsoid.isValid()) {
-    out.status = BoxEllipsoidStatus::InvalidInput;
-    out.reason = "refinement diverged";
-    return out;
-  }
+  if (!fitEllipsoid(K, views, options, prior, *centre, median(radii), &out)) return out;
   std::vector<double> ious;
   for (const BoxView& v : views) {
     const Projection p = project(out.ellipsoid, K, v.pose);
