@@ -90,22 +90,16 @@ RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>
 
 RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation>& observations,
                                                    const Pose& start) const {
-  RelocalizationResult result = scorePose(observations, start);
-  if (result.status == RelocalizationStatus::InvalidInput) return result;
+  const RelocalizationResult given = scorePose(observations, start);
+  if (given.status == RelocalizationStatus::InvalidInput) return given;
   std::vector<std::pair<int, std::string>> skipped;
   const Candidates candidates = collectCandidates(observations, map_, options_.scoring, &skipped);
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
   const std::optional<GravityPrior> no_gravity;
-  const RefinementContext context{observations, map_, K_, options_, no_gravity, GravityGate{nullptr, 0.0}};
+  const RefinementContext context{observations, map_, K_, options_, no_gravity, PoseGate{}};
   const ChosenPose refined = refineRounds(start, scorer, context);
-  result.pose = refined.pose;
-  result.cost = refined.cost;
+  RelocalizationResult result = scorePose(observations, refined.pose);
   result.refined = refined.refined;
-  reportMatches(refined.matches, &result);
-  const int needed = std::min(options_.scoring.min_inliers, std::max(candidates.num_usable, 1));
-  const bool enough = static_cast<int>(refined.matches.size()) >= needed;
-  result.status = enough ? RelocalizationStatus::Success : RelocalizationStatus::NoConsistentHypothesis;
-  result.reason = enough ? "" : "the pose explains " + std::to_string(refined.matches.size()) + " observation(s)";
   return result;
 }
 
@@ -145,8 +139,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   // 2. Hypotheses into the pool: triplets, then pairs when the frame has few observations or
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
-  const GravityGate gate{gravity ? &*gravity : nullptr, options_.gravity.gate_deg,
-                         options_.envelope ? &*options_.envelope : nullptr};
+  const PoseGate gate{gravity ? &*gravity : nullptr, options_.gravity.gate_deg,
+                      options_.envelope ? &*options_.envelope : nullptr};
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer);
   HypothesisPool pool(options_.refinement.top_k);
   SearchOutcome search;

@@ -120,7 +120,7 @@ class Mapper {
     int observations = 0;
     int last_seen = -1;
     bool confirmed = false;
-    std::optional<MappedObject> built;  // rebuilt after each update of a confirmed object
+    std::optional<MappedObject> built;  // rebuilt as a confirmed object is updated (boxes: as its views grow)
     size_t built_views = 0;             // boxes mode: views in the last fit
     int label() const;
   };

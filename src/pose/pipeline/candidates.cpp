@@ -21,7 +21,7 @@ Candidates collectCandidates(const std::vector<Observation>& observations, const
       const double share =
           m.category == o.category ? std::max(m.categoryShare(o.category), 0.5) : m.categoryShare(o.category);
       if (!mapObjectUsable(m) || !(share >= std::min(options.min_category_share, 0.5) &&
-                                      (m.category == o.category || share >= options.min_category_share)))
+                                   (m.category == o.category || share >= options.min_category_share)))
         continue;
       c.of_observation[i].push_back(static_cast<int>(j));
       // Likelier labels, surer detections and larger objects first: PROSAC order.

@@ -17,7 +17,7 @@ namespace ellreloc::pipeline {
 
 /// Drops poses that tilt the camera more than max(gate_deg, 5 sigma) away from a gravity prior,
 /// and poses outside the camera envelope.
-struct GravityGate {
+struct PoseGate {
   const GravityPrior* prior = nullptr;  // none: every pose passes
   double gate_deg = 15.0;
   const CameraEnvelope* envelope = nullptr;  // none: anywhere
@@ -40,8 +40,7 @@ class HypothesisEstimator {
   static constexpr int kMaxModels = 4;
 
   HypothesisEstimator(const std::vector<Observation>& observations, const Candidates& candidates, const ObjectMap& map,
-                      const Intrinsics& K, const RelocalizerOptions& options, const GravityGate& gate,
-                      PoseScorer& scorer)
+                      const Intrinsics& K, const RelocalizerOptions& options, const PoseGate& gate, PoseScorer& scorer)
       : observations_(observations),
         pairs_(candidates.pairs),
         map_(map),
@@ -75,7 +74,7 @@ class HypothesisEstimator {
   const ObjectMap& map_;
   const Intrinsics& K_;
   const RelocalizerOptions& options_;
-  GravityGate gate_;
+  PoseGate gate_;
   PoseScorer& scorer_;
 };
 

@@ -26,7 +26,7 @@ struct RefinementContext {
   const Intrinsics& K;
   const RelocalizerOptions& options;
   const std::optional<GravityPrior>& gravity;
-  GravityGate gate;
+  PoseGate gate;
 };
 
 /// Refines `start` on its matches, matches again at the refined pose, and repeats while that
