@@ -19,10 +19,10 @@ if [ "$what" = asan ] || [ "$what" = all ]; then
     >/dev/null
   cmake --build build-asan -j "$jobs"
   # Left out: the packaging test (installs and rebuilds the examples: nothing to sanitize) and
-  # the fr2_desk regression (198 relocalizations, 90 s under ASan; the CLI paths it takes are
-  # covered by the other CLI tests).
+  # the real-data regressions (fr2_desk: 198 relocalizations, 90 s under ASan; fr3: a 646-frame
+  # box map; the CLI paths they take are covered by the other CLI tests).
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-    ctest --test-dir build-asan --output-on-failure -j "$jobs" -E "packaging.consumer|Cli.Fr2Desk"
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" -E "packaging.consumer|Cli.Fr2Desk|Cli.Fr3Boxes"
 fi
 
 if [ "$what" = tsan ] || [ "$what" = all ]; then
