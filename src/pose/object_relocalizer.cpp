@@ -90,8 +90,8 @@ RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>
 
 RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation>& observations,
                                                    const Pose& start) const {
-  const RelocalizationResult given = scorePose(observations, start);
-  if (given.status == RelocalizationStatus::InvalidInput) return given;
+  if (!invalidInput(K_, std::nullopt, options_).empty() || !start.isValid())
+    return scorePose(observations, start);  // says why
   std::vector<std::pair<int, std::string>> skipped;
   const Candidates candidates = collectCandidates(observations, map_, options_.scoring, &skipped);
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);

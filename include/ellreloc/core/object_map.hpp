@@ -64,11 +64,8 @@ inline std::string mapObjectProblem(const MapObject& object) {
   return "";
 }
 
-/// mapObjectProblem(object) is empty, without building the text.
-inline bool mapObjectUsable(const MapObject& object) {
-  const Ellipsoid& e = object.ellipsoid;
-  return e.center().allFinite() && e.axes().allFinite() && e.axes().minCoeff() >= kMinSemiAxis &&
-         e.axes().maxCoeff() <= kMaxSemiAxis && isRotation(e.rotation());
-}
+/// The object can be used for relocalization (mapObjectProblem finds nothing; the text is
+/// only built for an unusable object).
+inline bool mapObjectUsable(const MapObject& object) { return mapObjectProblem(object).empty(); }
 
 }  // namespace ellreloc
