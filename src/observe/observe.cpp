@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "ellreloc/core/mask.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
 
 namespace ellreloc {
@@ -50,14 +51,17 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
     r.observation = obs;
     return r;
   }
-  // Paper and Mask policies: use the mask when it is usable.
-  if (!d.mask) {
+  // Paper and Mask policies: use the mask when it is usable; a polygon stands for a mask.
+  std::optional<RleMask> polygon_mask;
+  if (!d.mask && d.polygon.size() >= 3) polygon_mask = polygonMask(d.polygon, height, width);
+  const RleMask* mask = d.mask ? &*d.mask : polygon_mask ? &*polygon_mask : nullptr;
+  if (!mask) {
     r.note = "no mask: box-inscribed ellipse";
     r.observation = obs;
     return r;
   }
-  if (d.mask->height != height || d.mask->width != width) {
-    r.note = "mask size " + std::to_string(d.mask->height) + "x" + std::to_string(d.mask->width) +
+  if (mask->height != height || mask->width != width) {
+    r.note = "mask size " + std::to_string(mask->height) + "x" + std::to_string(mask->width) +
              " differs from the image " + std::to_string(height) + "x" + std::to_string(width) +
              ": box-inscribed ellipse";
     r.observation = obs;
@@ -65,13 +69,14 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   }
   // Everything below works on the runs: the cost follows the object's size, not the image's.
   uint64_t ones = 0;
-  for (size_t i = 1; i < d.mask->counts.size(); i += 2) ones += d.mask->counts[i];
-  if (!d.mask->isConsistent() || ones == 0) {
-    r.note = "empty or inconsistent mask: box-inscribed ellipse";
+  for (size_t i = 1; i < mask->counts.size(); i += 2) ones += mask->counts[i];
+  if (!mask->isConsistent() || ones == 0) {
+    r.note = polygon_mask ? "polygon covers no pixel centre: box-inscribed ellipse"
+                          : "empty or inconsistent mask: box-inscribed ellipse";
     r.observation = obs;
     return r;
   }
-  const RegularVerdict verdict = testRegularMask(*d.mask, opt.regular);
+  const RegularVerdict verdict = testRegularMask(*mask, opt.regular);
   obs.regular = verdict.regular;
   obs.truncated = obs.truncated || verdict.touches_border;
   if (opt.policy == ObservationPolicy::Paper && !verdict.regular) {
@@ -79,8 +84,8 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
     return r;
   }
   const MaskFitMethod method = verdict.regular ? opt.regular_fit : opt.irregular_fit;
-  std::optional<Ellipse> fitted = fitMaskEllipse(*d.mask, method, &verdict);
-  if (!fitted && method != MaskFitMethod::Moments) fitted = fitMaskEllipse(*d.mask, MaskFitMethod::Moments, &verdict);
+  std::optional<Ellipse> fitted = fitMaskEllipse(*mask, method, &verdict);
+  if (!fitted && method != MaskFitMethod::Moments) fitted = fitMaskEllipse(*mask, MaskFitMethod::Moments, &verdict);
   if (!fitted || !fitted->isValid()) {
     r.note = "ellipse fit failed: box-inscribed ellipse";
     r.observation = obs;

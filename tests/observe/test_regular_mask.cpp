@@ -2,13 +2,13 @@
 
 #include <map>
 
-#include "fixtures/data_dir.hpp"
-#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/observe/regular_mask.hpp"
+#include "fixtures/data_dir.hpp"
 #include "fixtures/mask_shapes.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;
@@ -192,6 +192,22 @@ TEST(Observe, PoliciesAndBadInput) {
   const ObserveResult rm = observeDetection(round, W, H, mask);
   EXPECT_EQ(rm.observation->source, EllipseSource::Mask);
   EXPECT_LT(wasserstein2(rm.observation->ellipse, Ellipse({100, 70}, {40, 25}, 0.3)), 1.0);
+  // A polygon stands for a mask under Paper and Mask, and gives the same observation.
+  Detection polygon = d;
+  polygon.mask.reset();
+  polygon.polygon = {{50, 40}, {150, 40}, {150, 100}, {50, 100}};
+  for (const ObserveOptions& o : {ObserveOptions(), mask}) {
+    const ObserveResult from_mask = observeDetection(d, W, H, o), from_polygon = observeDetection(polygon, W, H, o);
+    EXPECT_EQ(from_polygon.observation->source, EllipseSource::Mask);
+    EXPECT_EQ(from_polygon.observation->regular, from_mask.observation->regular);
+    EXPECT_LT(wasserstein2(from_polygon.observation->ellipse, from_mask.observation->ellipse), 1e-9);
+  }
+  EXPECT_EQ(observeDetection(polygon, W, H, bbox).observation->source, EllipseSource::Box);
+  Detection outside_polygon = polygon;
+  outside_polygon.polygon = {{-20, -20}, {-10, -20}, {-10, -10}};
+  r = observeDetection(outside_polygon, W, H, mask);
+  EXPECT_EQ(r.observation->source, EllipseSource::Box);
+  EXPECT_NE(r.note.find("polygon"), std::string::npos);
   // Given.
   ObserveOptions given;
   given.policy = ObservationPolicy::Given;

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -92,6 +93,59 @@ inline RleMask encodeMask(const BinaryMask& m) {
     }
   }
   rle.counts.push_back(run);
+  return rle;
+}
+
+/// The run-length mask of a polygon (even-odd rule): pixel (x, y) is set when its centre lies
+/// inside. Only the columns the polygon spans are visited, each against every edge, so the work
+/// is the polygon's width in pixels times its vertex count. Non-finite vertices give an empty
+/// mask; an image of more than 2^32 - 1 pixels, whose runs do not fit the format, no runs.
+inline RleMask polygonMask(const std::vector<Eigen::Vector2d>& polygon, int height, int width) {
+  RleMask rle;
+  rle.height = height;
+  rle.width = width;
+  const uint64_t total = static_cast<uint64_t>(std::max(height, 0)) * static_cast<uint64_t>(std::max(width, 0));
+  double xmin = INFINITY, xmax = -INFINITY;
+  bool finite = polygon.size() >= 3;
+  for (const Eigen::Vector2d& p : polygon) {
+    finite = finite && p.allFinite();
+    xmin = std::min(xmin, p.x()), xmax = std::max(xmax, p.x());
+  }
+  uint64_t pos = 0;  // the first pixel not yet covered by a run
+  const auto addOnes = [&](uint64_t start, uint64_t length) {
+    if (!rle.counts.empty() && start == pos) {  // continues the previous run of ones
+      rle.counts.back() += static_cast<uint32_t>(length);
+    } else {
+      rle.counts.push_back(static_cast<uint32_t>(start - pos));
+      rle.counts.push_back(static_cast<uint32_t>(length));
+    }
+    pos = start + length;
+  };
+  if (total > UINT32_MAX) return rle;
+  if (finite && total > 0) {
+    const int x0 = static_cast<int>(std::max(0.0, std::ceil(xmin)));
+    const int x1 = static_cast<int>(std::min(width - 1.0, std::floor(xmax)));
+    std::vector<double> crossings;
+    for (int x = x0; x <= x1; ++x) {
+      crossings.clear();
+      for (size_t i = 0; i < polygon.size(); ++i) {
+        const Eigen::Vector2d& a = polygon[i];
+        const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+        // Half-open in x, so a vertex on the column counts once.
+        if ((a.x() <= x) != (b.x() <= x)) crossings.push_back(a.y() + (x - a.x()) * (b.y() - a.y()) / (b.x() - a.x()));
+      }
+      std::sort(crossings.begin(), crossings.end());
+      for (size_t k = 0; k + 1 < crossings.size(); k += 2) {
+        // Pixel centres y with crossings[k] <= y < crossings[k + 1], inside the image.
+        const double y0 = std::max(0.0, std::ceil(crossings[k]));
+        const double y1 = std::min(static_cast<double>(height), std::ceil(crossings[k + 1]));
+        if (y1 > y0)
+          addOnes(static_cast<uint64_t>(x) * static_cast<uint64_t>(height) + static_cast<uint64_t>(y0),
+                  static_cast<uint64_t>(y1 - y0));
+      }
+    }
+  }
+  if (total - pos > 0 || rle.counts.empty()) rle.counts.push_back(static_cast<uint32_t>(total - pos));
   return rle;
 }
 
