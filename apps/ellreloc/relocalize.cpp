@@ -167,6 +167,22 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
   return options;
 }
 
+/// Each frame's timestamp, its file name's base name, under which its pose is written (as
+/// that text): checked before any work, so every frame needs one and no two may share one.
+std::vector<double> frameTimestamps(const std::vector<DetectionFrame>& frames, const std::string& path) {
+  std::vector<double> timestamps;
+  std::map<double, size_t> first;  // timestamp -> the first frame with it
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const std::optional<double> t = frames[i].timestamp();
+    const std::string where = path + ": [" + std::to_string(i) + "].file_name: '" + frames[i].file_name + "' ";
+    if (!t) throw Error(where + "has no numeric base name to use as a timestamp");
+    if (const auto [it, fresh] = first.emplace(*t, i); !fresh)
+      throw Error(where + "has the timestamp of frame [" + std::to_string(it->second) + "]");
+    timestamps.push_back(*t);
+  }
+  return timestamps;
+}
+
 /// One frame's entry of the --report JSON (with its diagnosis against a reference pose).
 nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResult& r, int observed,
                            const ObjectMap& map, const Pose* reference, const ReferenceScore& ref,
@@ -204,6 +220,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const ObjectMap object_map = io::readMap(a.map, &left_out);
   for (const std::string& w : left_out) std::fprintf(stderr, "warning: %s\n", w.c_str());
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
+  const std::vector<double> timestamps = frameTimestamps(frames, a.detections);
   std::string policy = a.policy;
   const RelocalizerOptions options = relocalizerOptions(a, &policy);
   ObserveOptions observe_options;
@@ -231,8 +248,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   if (!a.reference.empty()) {
     const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.reference, true);
     for (size_t i = 0; i < frames.size(); ++i) {
-      const std::optional<double> t = frames[i].timestamp();
-      if (const auto k = t ? io::findNearest(trajectory, *t) : std::nullopt) references[i] = trajectory[*k].pose;
+      if (const auto k = io::findNearest(trajectory, timestamps[i])) references[i] = trajectory[*k].pose;
     }
   }
 
@@ -256,12 +272,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     const nlohmann::json j =
         frameReport(frames[i], r, observed[i], object_map, reference, reference_scores[i], diagnosis);
     report.push_back(j);
-    if (r.status != RelocalizationStatus::Success) continue;
-    const std::optional<double> t = frames[i].timestamp();
-    if (!t)
-      throw Error(a.detections + ": [" + std::to_string(i) + "].file_name: '" + frames[i].file_name +
-                  "' has no numeric base name to use as a timestamp");
-    poses.push_back({*t, r.pose});
+    if (r.status == RelocalizationStatus::Success) poses.push_back({timestamps[i], r.pose, frames[i].timestampText()});
   }
   io::writeTumTrajectory(a.out, poses);
   if (!a.report.empty()) io::writeFileAtomically(a.report, report.dump(1) + "\n");

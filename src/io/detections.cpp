@@ -1,10 +1,11 @@
 #include "ellreloc/io/detections.hpp"
 
+#include <cstdlib>
+#include <unordered_map>
+
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 #include "json_fields.hpp"
-
-#include <cstdlib>
 
 namespace ellreloc {
 
@@ -86,6 +87,7 @@ std::vector<DetectionFrame> parseDetectionsJson(const std::string& text, const s
   if (!j.is_array()) top.fail("expected an array of frames");
   std::vector<DetectionFrame> frames;
   frames.reserve(j.size());
+  std::unordered_map<std::string, size_t> seen;  // file name -> its frame's index
   for (size_t f = 0; f < j.size(); ++f) {
     const Where where = top[f];
     const json& fr = j[f];
@@ -94,9 +96,12 @@ std::vector<DetectionFrame> parseDetectionsJson(const std::string& text, const s
     const json& name = detail::member(fr, "file_name", where);
     if (!name.is_string() || name.get<std::string>().empty()) where["file_name"].fail("expected a non-empty string");
     frame.file_name = name.get<std::string>();
+    if (const auto [it, fresh] = seen.emplace(frame.file_name, f); !fresh)
+      where["file_name"].fail("'" + frame.file_name + "' repeats frame [" + std::to_string(it->second) + "]");
     const json& dets = detail::member(fr, "detections", where);
     if (!dets.is_array()) where["detections"].fail("expected an array");
-    for (size_t i = 0; i < dets.size(); ++i) frame.detections.push_back(parseDetection(dets[i], where["detections"][i]));
+    for (size_t i = 0; i < dets.size(); ++i)
+      frame.detections.push_back(parseDetection(dets[i], where["detections"][i]));
     if (fr.contains("keypoints")) {
       const json& kps = fr["keypoints"];
       if (!kps.is_array()) where["keypoints"].fail("expected an array of [point_index, u, v]");
@@ -115,14 +120,18 @@ std::vector<DetectionFrame> parseDetectionsJson(const std::string& text, const s
   return frames;
 }
 
-std::vector<DetectionFrame> readDetections(const std::string& path) { return parseDetectionsJson(readTextFile(path), path); }
+std::vector<DetectionFrame> readDetections(const std::string& path) {
+  return parseDetectionsJson(readTextFile(path), path);
+}
 
 void writeDetections(const std::string& path, const std::vector<DetectionFrame>& frames) {
   json out = json::array();
   for (const DetectionFrame& frame : frames) {
     json dets = json::array();
     for (const Detection& d : frame.detections) {
-      json jd = {{"category_id", d.category_id}, {"detection_score", d.score}, {"bbox", {d.bbox.x1, d.bbox.y1, d.bbox.x2, d.bbox.y2}}};
+      json jd = {{"category_id", d.category_id},
+                 {"detection_score", d.score},
+                 {"bbox", {d.bbox.x1, d.bbox.y1, d.bbox.x2, d.bbox.y2}}};
       if (d.mask) jd["mask"] = {{"size", {d.mask->height, d.mask->width}}, {"counts", encodeRleString(d.mask->counts)}};
       if (!d.polygon.empty()) {
         json poly = json::array();

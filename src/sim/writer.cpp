@@ -88,7 +88,7 @@ SimulationSummary writeSimulation(const std::string& dir, const SimulationOption
       wrote("mapping/rgb/" + name);
     }
     assoc << stamp(t) << " rgb/" << name << " " << stamp(t) << " depth/" << name << "\n";
-    mapping_poses.push_back({t, mapping[i]});
+    mapping_poses.push_back({t, mapping[i], stamp(t)});
     mapping_dets.push_back({"rgb/" + name, detect(scene, f, noise, rng), {}});
   }
   io::writeFileAtomically(dir + "/mapping/associations.txt", assoc.str());
@@ -111,7 +111,7 @@ SimulationSummary writeSimulation(const std::string& dir, const SimulationOption
       writeRgb(dir + "/query/rgb/" + name, f);
       wrote("query/rgb/" + name);
     }
-    query_poses.push_back({t, query[i]});
+    query_poses.push_back({t, query[i], stamp(t)});
     query_dets.push_back(
         {"rgb/" + name, detect(scene, f, noise, rng), keypoints(scene, f, opt.camera, query[i], noise, rng)});
     summary.query_detections += static_cast<int>(query_dets.back().detections.size());

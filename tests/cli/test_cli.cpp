@@ -83,6 +83,12 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
             dir);
     ASSERT_EQ(r.code, 0) << method << ": " << r.err;
     EXPECT_TRUE(fs::exists(dir.path(method + ".json")));
+    // Each pose carries its frame's timestamp as the file name writes it.
+    std::istringstream poses(readFile(dir.path(method + ".txt")));
+    const std::string query_frames = readFile(s + "/query/detections.json");
+    for (std::string line; std::getline(poses, line);)
+      if (line[0] != '#')
+        EXPECT_NE(query_frames.find("\"rgb/" + line.substr(0, line.find(' ')) + ".png\""), std::string::npos) << line;
     r = run("evaluate --groundtruth " + s + "/query/groundtruth.txt --estimate " + dir.path(method + ".txt") +
                 " --detections " + s + "/query/detections.json --plot " + dir.path(method + ".png"),
             dir);
@@ -273,6 +279,10 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
             "{\"objects\": [{\"id\": 0, \"category_id\": 1, \"center\": [0, 0, 0], \"axes\": [0.1, -0.2, 0.3], "
             "\"rotation\": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}]}");
   writeFile(dir.path("bad_camera.yaml"), "Camera.fx: -3\n");
+  const std::string frame = R"(, "detections": [{"category_id": 1, "bbox": [1, 2, 30, 40]}]})";
+  writeFile(dir.path("same_time.json"),
+            "[{\"file_name\": \"rgb/1.5.png\"" + frame + ", {\"file_name\": \"depth/1.50.png\"" + frame + "]");
+  writeFile(dir.path("no_time.json"), "[{\"file_name\": \"rgb/first.png\"" + frame + "]");
   const std::string out = dir.path("out.txt");
   const std::string reloc = "relocalize --camera " + d + "/camera.yaml --out " + out + " ";
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -281,6 +291,8 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
       {"truncated JSON", reloc + "--map " + d + "/map.json --detections " + dir.path("truncated.json")},
       {"wrong type", reloc + "--map " + d + "/map.json --detections " + dir.path("wrong_type.json")},
       {"NaN", reloc + "--map " + d + "/map.json --detections " + dir.path("nan.json")},
+      {"two frames at one time", reloc + "--map " + d + "/map.json --detections " + dir.path("same_time.json")},
+      {"a frame without a time", reloc + "--map " + d + "/map.json --detections " + dir.path("no_time.json")},
       {"negative axes",
        reloc + "--map " + dir.path("negative_axes.json") + " --detections " + d + "/keyframes.detections.json"},
       {"bad camera", "relocalize --camera " + dir.path("bad_camera.yaml") + " --out " + out + " --map " + d +

@@ -168,6 +168,7 @@ TEST(DetectionsIo, MalformedFilesNameTheField) {
       {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + R"(, "ellipse": {"center": [1, 2], "axes": [1, 2]}}]}])", "ellipse.angle: missing"},
       {"[{\"file_name\": \"a.png\", \"detections\": [], \"keypoints\": [[1, 2]]}]", "[0].keypoints[0]: expected [point_index, u, v]"},
       {"[{\"file_name\": \"a.png\", \"detections\": [], \"keypoints\": [[-1, 2, 3]]}]", "[0].keypoints[0][0]: point index must be >= 0"},
+      {"[{\"file_name\": \"a.png\", \"detections\": []}, {\"file_name\": \"a.png\", \"detections\": []}]", "[1].file_name: 'a.png' repeats frame [0]"},
   };
   test::TempDir dir;
   int n = 0;

@@ -1,12 +1,13 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 #include "ellreloc/io/trajectory.hpp"
-
 #include "fixtures/data_dir.hpp"
 #include "fixtures/random_geometry.hpp"
 #include "fixtures/temp_dir.hpp"
-
-#include <gtest/gtest.h>
 
 using namespace ellreloc;
 
@@ -57,6 +58,9 @@ TEST(TrajectoryIo, MalformedLinesAreNamed) {
       {"1.0 1 2 3 0 0 0 1\n2.0 1 2 3 0 0 0 0\n", "line 2: zero quaternion"},
       {"1.0 1 2 x 0 0 0 1\n", "line 1: expected"},
       {"1.0 1 2 1e999 0 0 0 1\n", "line 1"},
+      {"1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n1.00 0 0 0 0 0 0 1\n", "line 3: timestamp 1.00 repeats line 1"},
+      {"nan 0 0 0 0 0 0 1\n", "line 1: timestamp 'nan' is not a finite number"},
+      {"0x10 0 0 0 0 0 0 1\n", "line 1: timestamp '0x10' is not a finite number"},
   };
   test::TempDir dir;
   int n = 0;
@@ -70,5 +74,33 @@ TEST(TrajectoryIo, MalformedLinesAreNamed) {
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
       EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u) << e.what();
     }
+  }
+}
+
+TEST(TrajectoryIo, TimestampsAreWrittenExactlyAsRead) {
+  // Two stamps 0.3 us apart, below the 6 decimals of the usual printf, keep their own text;
+  // stamps given only as numbers get the shortest text that reads back as the same double.
+  test::TempDir dir;
+  const std::string in = "1311868164.3631811 0 0 0 0 0 0 1\n1311868164.3631814 1 0 0 0 0 0 1\n1e3 2 0 0 0 0 0 1\n";
+  io::writeFileAtomically(dir.path("in.txt"), in);
+  std::vector<io::StampedPose> poses = io::readTumTrajectory(dir.path("in.txt"));
+  ASSERT_EQ(poses.size(), 3u);
+  EXPECT_EQ(poses[0].stamp, "1311868164.3631811");
+  EXPECT_NE(poses[0].timestamp, poses[1].timestamp);
+  poses.push_back({1311868164.1, poses[0].pose});
+  poses.push_back({0.1 + 0.2, poses[0].pose});
+  io::writeTumTrajectory(dir.path("out.txt"), poses);
+  std::vector<std::string> stamps;
+  for (const io::StampedPose& p : io::readTumTrajectory(dir.path("out.txt"))) stamps.push_back(p.stamp);
+  EXPECT_EQ(stamps, (std::vector<std::string>{"1311868164.3631811", "1311868164.3631814", "1e3", "1311868164.1",
+                                              "0.30000000000000004"}));
+  // The writer refuses what the reader would refuse, and leaves no file.
+  const std::vector<std::vector<io::StampedPose>> refused = {
+      {poses[0], {1311868164.3631811, poses[0].pose}},  // the same timestamp twice
+      {{1.0, poses[0].pose, "1.0 2"}},                  // a stamp that is not one number
+  };
+  for (const auto& bad : refused) {
+    EXPECT_THROW(io::writeTumTrajectory(dir.path("bad.txt"), bad), Error);
+    EXPECT_FALSE(std::ifstream(dir.path("bad.txt")).good());
   }
 }

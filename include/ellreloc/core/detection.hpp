@@ -4,6 +4,7 @@
 /// masks (COCO RLE), polygons or ready-made ellipses, and keypoints matched to the map's points.
 
 #include <Eigen/Core>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -47,13 +48,13 @@ struct DetectionFrame {
     if (dot != std::string::npos && dot > 0) base = base.substr(0, dot);
     return base;
   }
-  /// timestampText() as a number; nullopt when it is not one.
+  /// timestampText() as a number (a plain decimal, as TUM files write them); nullopt when it
+  /// is not one.
   std::optional<double> timestamp() const {
     const std::string text = timestampText();
-    if (text.empty()) return std::nullopt;
-    char* end = nullptr;
-    const double t = std::strtod(text.c_str(), &end);
-    if (end != text.c_str() + text.size() || !std::isfinite(t)) return std::nullopt;
+    double t = 0.0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), t);
+    if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(t)) return std::nullopt;
     return t;
   }
 };

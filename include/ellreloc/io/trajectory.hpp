@@ -13,15 +13,20 @@ namespace ellreloc::io {
 
 struct StampedPose {
   double timestamp = 0.0;
-  Pose pose;  ///< world->camera
+  Pose pose;          ///< world->camera
+  std::string stamp;  ///< the timestamp's text as read or to be written; empty: `timestamp` decides
 };
 
 /// Reads a TUM trajectory; `#` starts a comment. Quaternions are normalised; a zero or
-/// non-finite one is an error naming the line. Throws ellreloc::Error on malformed input, and
-/// on a file without poses unless `allow_empty` (a run that relocalized no frame writes one).
+/// non-finite one is an error naming the line, and so is a timestamp equal to an earlier line's.
+/// Throws ellreloc::Error on malformed input, and on a file without poses unless `allow_empty`
+/// (a run that relocalized no frame writes one).
 std::vector<StampedPose> readTumTrajectory(const std::string& path, bool allow_empty = false);
 
-/// Writes camera->world lines with full precision, atomically.
+/// Writes camera->world lines atomically: each timestamp as its `stamp` text when there is one
+/// (so "1311868164.3631811" stays that), else the shortest decimal that reads back as the same
+/// double; poses with full precision. Throws on an invalid pose, a non-finite or malformed
+/// timestamp and two poses at the same timestamp.
 void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses);
 
 /// Index of the pose whose timestamp is nearest to t, if within `tolerance` seconds.
