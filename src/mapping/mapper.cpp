@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 #include "ellreloc/core/projection.hpp"
@@ -35,11 +36,68 @@ int Mapper::Track::label() const {
   return best;
 }
 
+std::string MapperOptions::validate() const {
+  struct Range {
+    const char* name;
+    double value, lo, hi;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  const Range ranges[] = {
+      {"voxels.voxel_size", voxels.voxel_size, 1e-6, 1e3},
+      {"voxels.hit_probability", voxels.hit_probability, 0, 1},
+      {"voxels.miss_probability", voxels.miss_probability, 0, 1},
+      {"voxels.clamp_min", voxels.clamp_min, 0, voxels.clamp_max},
+      {"voxels.clamp_max", voxels.clamp_max, 0, 1},
+      {"voxels.occupied_probability", voxels.occupied_probability, 0, 1},
+      {"voxels.depth_tolerance", voxels.depth_tolerance, 0, inf},
+      {"voxels.min_depth", voxels.min_depth, 0, voxels.max_depth},
+      {"voxels.max_depth", voxels.max_depth, 0, 1e6},
+      {"voxels.depth_gate_sigmas", voxels.depth_gate_sigmas, 0, inf},
+      {"voxels.depth_gate_min", voxels.depth_gate_min, 0, inf},
+      {"voxels.pixel_stride", double(voxels.pixel_stride), 1, 1e6},
+      {"voxels.max_voxels", double(voxels.max_voxels), 1, inf},
+      {"tracking.label_weight", tracking.label_weight, 0, inf},
+      {"tracking.iou_weight", tracking.iou_weight, 0, inf},
+      {"tracking.min_iou", tracking.min_iou, 0, 1},
+      {"tracking.min_iou_other_label", tracking.min_iou_other_label, 0, 1},
+      {"tracking.match_radius", tracking.match_radius, 0, inf},
+      {"tracking.match_ratio", tracking.match_ratio, 0, 1},
+      {"ellipsoid.low_percentile", ellipsoid.low_percentile, 0, ellipsoid.high_percentile},
+      {"ellipsoid.high_percentile", ellipsoid.high_percentile, 0, 1},
+      {"ellipsoid.extent_padding", ellipsoid.extent_padding, 0, inf},
+      {"boxes.min_views", double(boxes.min_views), 2, inf},
+      {"boxes.min_baseline_deg", boxes.min_baseline_deg, 0, 180},
+      {"boxes.border_px", boxes.border_px, 0, inf},
+      {"boxes.min_median_iou", boxes.min_median_iou, 0, 1},
+      {"boxes.max_iterations", double(boxes.max_iterations), 0, inf},
+      {"boxes.max_views", double(boxes.max_views), double(boxes.min_views), inf},
+      {"min_observations", double(min_observations), 1, inf},
+      {"prune_probability", prune_probability, 0, 1},
+      {"ellipsoid_min_probability", ellipsoid_min_probability, 0, 1},
+      {"track_window", double(track_window), 1, inf},
+      {"candidate_lifetime", double(candidate_lifetime), 1, inf},
+      {"min_score", min_score, -inf, inf},
+      {"floor.max_tilt_deg", floor.max_tilt_deg, 0, 90},
+      {"floor.inlier_distance", floor.inlier_distance, 0, inf},
+      {"floor.min_inlier_share", floor.min_inlier_share, 0, 1},
+      {"floor.pixel_stride", double(floor.pixel_stride), 1, 1e6},
+      {"floor.iterations", double(floor.iterations), 1, inf},
+      {"min_mask_pixels", double(min_mask_pixels), 0, inf},
+  };
+  for (const Range& r : ranges)
+    if (!(r.value >= r.lo && r.value <= r.hi))  // NaN fails too
+      return std::string(r.name) + " is " + std::to_string(r.value) + ", outside [" + std::to_string(r.lo) + ", " +
+             std::to_string(r.hi) + "]";
+  const auto unit = [](const Eigen::Vector3d& v) { return v.allFinite() && v.norm() > 1e-9; };
+  if (!unit(ellipsoid.up)) return "ellipsoid.up is zero or not finite";
+  if (!unit(floor.prior_up)) return "floor.prior_up is zero or not finite";
+  if (boxes.up && !unit(*boxes.up)) return "boxes.up is zero or not finite";
+  return "";
+}
+
 Mapper::Mapper(const Intrinsics& K, const MapperOptions& options) : K_(K), options_(options) {
   if (!K.isValid()) throw Error("mapper: invalid camera intrinsics");
-  if (!(options.voxels.voxel_size > 0.0) || options.min_observations < 1 || options.track_window < 1 ||
-      options.candidate_lifetime < 1)
-    throw Error("mapper: voxel size must be positive and min_observations, track_window, candidate_lifetime >= 1");
+  if (const std::string problem = options.validate(); !problem.empty()) throw Error("mapper: " + problem);
 }
 
 void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const {

@@ -22,8 +22,31 @@ std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, MaskFitMethod method, 
   return std::nullopt;
 }
 
+std::string ObserveOptions::validate() const {
+  const RegularMaskOptions& m = regular;
+  const std::pair<const char*, bool> checks[] = {
+      {"border_px", border_px >= 0 && std::isfinite(border_px)},
+      {"regular.min_solidity", m.min_solidity >= 0 && m.min_solidity <= 1},
+      {"regular.min_fill", m.min_fill >= 0 && m.min_fill <= m.max_fill},
+      {"regular.max_fill", std::isfinite(m.max_fill)},
+      {"regular.noise_band_px", m.noise_band_px >= 0 && std::isfinite(m.noise_band_px)},
+      {"regular.min_core_fill", m.min_core_fill >= 0 && m.min_core_fill <= 1},
+      {"regular.max_corner_angle_deg", m.max_corner_angle_deg >= 0 && m.max_corner_angle_deg <= 180},
+      {"regular.min_corner_angle_deg", m.min_corner_angle_deg >= 0 && m.min_corner_angle_deg <= m.max_corner_angle_deg},
+      {"regular.min_pixels", m.min_pixels >= 0},
+  };
+  for (const auto& [name, ok] : checks)
+    if (!ok) return std::string("observe options: ") + name + " is out of range or not a number";
+  return "";
+}
+
 ObserveResult observeDetection(const Detection& d, int width, int height, const ObserveOptions& opt) {
   ObserveResult r;
+  if (std::string problem = opt.validate(); !problem.empty()) {
+    r.status = ObserveStatus::InvalidOptions;
+    r.note = std::move(problem);
+    return r;
+  }
   const Box image(-0.5, -0.5, width - 0.5, height - 0.5);
   if (!d.bbox.isValid() || !(d.bbox.width() > 0) || !(d.bbox.height() > 0) ||
       !(d.bbox.intersection(image).area() > 0)) {

@@ -7,8 +7,8 @@
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/mapping/mapper.hpp"
-#include "fixtures/temp_dir.hpp"
 #include "fixtures/sim_sequence.hpp"
+#include "fixtures/temp_dir.hpp"
 
 namespace ellreloc {
 namespace {
@@ -178,6 +178,31 @@ TEST(Mapper, BadKeyframesAreErrorsAndLeaveTheMapUnchanged) {
   EXPECT_EQ(after.keyframes, before.keyframes);
   EXPECT_EQ(after.voxels, before.voxels);
   EXPECT_THROW(Mapper{Intrinsics()}, Error);
+}
+
+TEST(Mapper, OptionsOutOfRangeAreRefusedNamingTheField) {
+  EXPECT_EQ(MapperOptions().validate(), "");
+  const auto problem = [](void (*change)(MapperOptions&)) {
+    MapperOptions o;
+    change(o);
+    try {
+      Mapper mapper(Intrinsics(525.0, 525.0, 319.5, 239.5, 640, 480), o);
+      return std::string("accepted");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+  };
+  EXPECT_NE(problem([](MapperOptions& o) { o.voxels.voxel_size = NAN; }).find("voxels.voxel_size"), std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.voxels.hit_probability = 1.5; }).find("voxels.hit_probability"),
+            std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.voxels.min_depth = 9; }).find("voxels.min_depth"), std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.tracking.min_iou = -0.1; }).find("tracking.min_iou"), std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.prune_probability = INFINITY; }).find("prune_probability"),
+            std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.boxes.max_views = 1; }).find("boxes.max_views"), std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.boxes.up = Eigen::Vector3d::Zero(); }).find("boxes.up"),
+            std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.min_score = NAN; }).find("min_score"), std::string::npos);
 }
 
 TEST(Mapper, ReadsWhileMappingAndExportToTheMapFormat) {

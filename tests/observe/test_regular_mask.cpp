@@ -243,6 +243,16 @@ TEST(Observe, PoliciesAndBadInput) {
   Detection flat = d;
   flat.bbox = Box(10, 10, 10, 20);
   EXPECT_EQ(observeDetection(flat, W, H).status, ObserveStatus::InvalidBox);
+  // Options out of range: a status naming the field, no observation.
+  ObserveOptions nan_border;
+  nan_border.border_px = NAN;
+  r = observeDetection(d, W, H, nan_border);
+  EXPECT_EQ(r.status, ObserveStatus::InvalidOptions);
+  EXPECT_FALSE(r.observation.has_value());
+  EXPECT_NE(r.note.find("border_px"), std::string::npos);
+  ObserveOptions crossed = mask;
+  crossed.regular.min_fill = 2.0;  // above max_fill
+  EXPECT_NE(observeDetection(d, W, H, crossed).note.find("regular.min_fill"), std::string::npos);
   // Truncation: a box at the image border is flagged.
   Detection edge = d;
   edge.bbox = Box(-0.5, 10, 40, 60);

@@ -58,6 +58,10 @@ struct MapperOptions {
   bool estimate_up_from_floor = false;
   FloorOptions floor;
   long min_mask_pixels = 30;  ///< smaller masks are ignored
+
+  /// Empty when every field is finite and in range, else one line naming the first that is
+  /// not; the Mapper's constructor throws it.
+  std::string validate() const;
 };
 
 /// What one keyframe did.

@@ -33,12 +33,17 @@ struct ObserveOptions {
   MaskFitMethod irregular_fit = MaskFitMethod::Direct;       ///< for other masks (policy Mask)
   RegularMaskOptions regular;
   double border_px = 2.0;  ///< a box this close to the image border is flagged truncated
+
+  /// Empty when every threshold is finite and in range, else one line naming the first that
+  /// is not; observeDetection then answers InvalidOptions.
+  std::string validate() const;
 };
 
 enum class ObserveStatus {
   Ok,
-  InvalidBox,  ///< NaN, empty, or wholly outside the image: no observation
-  NoEllipse,   ///< policy Given without an `ellipse`, or an invalid one: no observation
+  InvalidBox,      ///< NaN, empty, or wholly outside the image: no observation
+  NoEllipse,       ///< policy Given without an `ellipse`, or an invalid one: no observation
+  InvalidOptions,  ///< ObserveOptions::validate() failed (`note` names the field): no observation
 };
 
 struct ObserveResult {
