@@ -2,6 +2,8 @@
 // Run: ./build/benchmarks/bench_pose --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <sys/resource.h>
+
 #include <random>
 
 #include "ellreloc/core/projection.hpp"
@@ -95,6 +97,40 @@ void BM_RelocalizeWorstCase200x50(benchmark::State& state) {
   state.counters["hypotheses"] = hypotheses;
 }
 BENCHMARK(BM_RelocalizeWorstCase200x50)->Iterations(5)->Unit(benchmark::kMillisecond);
+
+/// Absurd input a host must still survive (docs/reliability.md): N objects of one category and
+/// M observations of it, ours and the OA-SLAM preset, default options. One frame each; the
+/// counter peak_MB is the process's peak memory so far (the largest case runs last).
+void BM_RelocalizeHugeFrame(benchmark::State& state) {
+  const int objects = static_cast<int>(state.range(0)), observations = static_cast<int>(state.range(1));
+  const Room room = makeRoom(objects, 1, 1, 7);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Observation> frame = observe(room, room.cameras[0], observations, rng);
+  while (static_cast<int>(frame.size()) < observations) {  // clutter of the same category
+    Observation o;
+    o.category = 0;
+    o.ellipse = Ellipse({640 * u(rng), 480 * u(rng)}, {5 + 40 * u(rng), 5 + 20 * u(rng)}, u(rng));
+    o.box = o.ellipse.boundingBox();
+    frame.push_back(o);
+  }
+  const ObjectRelocalizer reloc(room.map, kK, state.range(2) ? RelocalizerOptions::oaSlam() : RelocalizerOptions());
+  RelocalizationResult r;
+  for (auto _ : state) r = reloc.relocalize(frame);
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  state.counters["hypotheses"] = static_cast<double>(r.hypotheses);
+  state.counters["skipped"] = static_cast<double>(r.skipped.size());
+  state.counters["peak_MB"] = static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+BENCHMARK(BM_RelocalizeHugeFrame)
+    ->ArgNames({"objects", "observations", "oaslam"})
+    ->Args({2000, 1000, 0})
+    ->Args({2000, 1000, 1})
+    ->Args({10000, 10000, 0})
+    ->Args({10000, 10000, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

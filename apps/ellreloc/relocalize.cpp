@@ -187,9 +187,16 @@ std::vector<double> frameTimestamps(const std::vector<DetectionFrame>& frames, c
 nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResult& r, int observed,
                            const ObjectMap& map, const Pose* reference, const ReferenceScore& ref,
                            const std::string& diagnosis) {
-  nlohmann::json j = {{"file_name", frame.file_name},   {"status", toString(r.status)}, {"reason", r.reason},
-                      {"observations", observed},       {"inliers", r.inliers.size()},  {"score", r.cost},
-                      {"mean_overlap", r.mean_overlap}, {"hypotheses", r.hypotheses},   {"time_ms", r.time_ms}};
+  nlohmann::json j = {{"file_name", frame.file_name},
+                      {"status", toString(r.status)},
+                      {"reason", r.reason},
+                      {"observations", observed},
+                      {"inliers", r.inliers.size()},
+                      {"score", r.cost},
+                      {"mean_overlap", r.mean_overlap},
+                      {"hypotheses", r.hypotheses},
+                      {"budget_exhausted", r.budget_exhausted},
+                      {"time_ms", r.time_ms}};
   nlohmann::json matches = nlohmann::json::array();
   for (const ObjectCorrespondence& c : r.inliers)
     matches.push_back({{"observation", c.observation},

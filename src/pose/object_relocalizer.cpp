@@ -76,7 +76,8 @@ RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>
     result.reason = invalid.empty() ? "invalid pose" : invalid;
     return result;
   }
-  const Candidates candidates = collectCandidates(observations, map_, options_.scoring, &result.skipped);
+  const Candidates candidates =
+      collectCandidates(observations, map_, options_.scoring, options_.search.max_candidate_pairs, &result.skipped);
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
   std::vector<ObjectCorrespondence> matches;
   result.cost = scorer.cost(pose, kReportIoUVertices, &matches);
@@ -93,7 +94,8 @@ RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation
   if (!invalidInput(K_, std::nullopt, options_).empty() || !start.isValid())
     return scorePose(observations, start);  // says why
   std::vector<std::pair<int, std::string>> skipped;
-  const Candidates candidates = collectCandidates(observations, map_, options_.scoring, &skipped);
+  const Candidates candidates =
+      collectCandidates(observations, map_, options_.scoring, options_.search.max_candidate_pairs, &skipped);
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
   const std::optional<GravityPrior> no_gravity;
   const RefinementContext context{observations, map_, K_, options_, no_gravity, PoseGate{}};
@@ -127,7 +129,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   if (!invalid.empty()) return finish(RelocalizationStatus::InvalidInput, invalid);
 
   // 1. Candidates: three usable observations for P3P, two for the two-object solver, one with gravity.
-  const Candidates candidates = collectCandidates(observations, map_, options_.scoring, &result.skipped);
+  const Candidates candidates =
+      collectCandidates(observations, map_, options_.scoring, options_.search.max_candidate_pairs, &result.skipped);
   const int usable = candidates.num_usable;
   const bool few = options_.few_objects.enabled;
   const int needed = !few ? 3 : (gravity ? 1 : 2);
@@ -144,9 +147,10 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer);
   HypothesisPool pool(options_.refinement.top_k);
   SearchOutcome search;
-  if (usable >= 3) searchTriplets(estimator, options_, map_.objects.size(), usable, &pool, &search);
+  const FrameBudget budget = frameBudget(options_.search, map_.objects.size(), usable, start);
+  if (usable >= 3) searchTriplets(estimator, options_, budget, &pool, &search);
   if (few && (usable <= options_.few_objects.max_observations || search.best_inliers < 3))
-    searchFewObjects(estimator, candidates, options_, gravity, &pool, &search);
+    searchFewObjects(estimator, candidates, options_, gravity, budget, &pool, &search);
   result.hypotheses = search.hypotheses;
   result.few_object_hypotheses = search.few_object_hypotheses;
   result.iterations = search.iterations;
@@ -156,7 +160,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
 
   // 3. Refinement of the pooled hypotheses, then with the keypoints.
   const RefinementContext context{observations, map_, K_, options_, gravity, gate};
-  ChosenPose chosen = refineHypotheses(pool, search.best, scorer, context);
+  // Past the time budget only the best hypothesis is refined: the bound is the budget plus one refinement.
+  ChosenPose chosen = refineHypotheses(pool, search.best, scorer, context, budget.timeUp() ? 1 : pool.entries().size());
   chosen = refineWithPoints(std::move(chosen), pointMatches(keypoints, map_), scorer, context);
 
   // 4. The result.

@@ -183,7 +183,6 @@ TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
   EXPECT_TRUE(a.budget_exhausted);
   RelocalizerOptions work_only;  // the machine-independent bound: 3e6 overlaps = 300 hypotheses here
   work_only.search.max_overlap_evaluations = 200L * 50 * 300;
-  work_only.search.min_hypotheses = 10;
   const RelocalizationResult w = ObjectRelocalizer(s.map, K, work_only).relocalize(s.observations);
   EXPECT_LE(w.hypotheses, 300 + 4);
   EXPECT_TRUE(w.budget_exhausted);
@@ -194,6 +193,54 @@ TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
   const RelocalizationResult b = ObjectRelocalizer(s.map, K, time_only).relocalize(s.observations);
   EXPECT_TRUE(b.budget_exhausted);  // stopped by the clock, not by running out of triplets
   EXPECT_LT(b.hypotheses, 1L << 30);
+  // The OA-SLAM preset's exhaustive search is bounded the same way (by default at 2e8 overlaps,
+  // 20,000 hypotheses here; 300 in this test, for time).
+  RelocalizerOptions preset = RelocalizerOptions::oaSlam();
+  EXPECT_EQ(preset.search.max_overlap_evaluations, 200000000L);
+  preset.search.max_overlap_evaluations = 200L * 50 * 300;
+  const RelocalizationResult p = ObjectRelocalizer(s.map, K, preset).relocalize(s.observations);
+  EXPECT_LE(p.hypotheses, 300 + 4);
+  EXPECT_TRUE(p.budget_exhausted);
+  // No pair table beyond its bound: the least confident observations are left out, named.
+  RelocalizerOptions few_pairs;
+  few_pairs.search.max_candidate_pairs = 200 * 10;  // every object is a candidate: 10 observations
+  const RelocalizationResult c = ObjectRelocalizer(s.map, K, few_pairs).relocalize(s.observations);
+  EXPECT_EQ(c.skipped.size(), 40u);
+  for (const auto& [index, reason] : c.skipped) EXPECT_NE(reason.find("max_candidate_pairs"), std::string::npos);
+}
+
+// Every path honours max_hypotheses and max_time_ms, 0 hypotheses included: triplets,
+// the two-object solver, the one-object solver with gravity.
+TEST(ObjectRelocalizer, BudgetsHoldOnEveryPathIncludingZero) {
+  std::mt19937 rng(92);
+  const Intrinsics K = test::testIntrinsics();
+  const Synthetic s = makeSceneSeeing(rng, 6, 30, 2);
+  const std::vector<Observation> two(s.observations.begin(), s.observations.begin() + 2);
+  const std::vector<Observation> one(s.observations.begin(), s.observations.begin() + 1);
+  const GravityPrior gravity{s.truth.rotation() * Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ(), 1.0};
+  const ObjectRelocalizer unbounded(s.map, K);
+  ASSERT_GT(unbounded.relocalize(two).few_object_hypotheses, 0);
+  ASSERT_GT(unbounded.relocalize(one, {}, gravity).few_object_hypotheses, 0);
+  for (long max_hypotheses : {0L, 3L}) {
+    RelocalizerOptions o;
+    o.search.budget.max_hypotheses = max_hypotheses;
+    const ObjectRelocalizer bounded(s.map, K, o);
+    for (const auto& [observations, prior] : {std::pair(s.observations, std::optional<GravityPrior>()),
+                                              std::pair(two, std::optional<GravityPrior>()),
+                                              std::pair(one, std::optional<GravityPrior>(gravity))}) {
+      const RelocalizationResult r = bounded.relocalize(observations, {}, prior);
+      EXPECT_LE(r.hypotheses, max_hypotheses + (observations.size() > 2 ? 3 : 0)) << observations.size();
+      if (max_hypotheses == 0) EXPECT_EQ(r.status, RelocalizationStatus::NoConsistentHypothesis);
+    }
+  }
+  // A budget spent before the search starts: no hypothesis at all, on every path.
+  RelocalizerOptions no_time;
+  no_time.search.budget.max_time_ms = 1e-9;
+  const ObjectRelocalizer hurried(s.map, K, no_time);
+  EXPECT_EQ(hurried.relocalize(s.observations).hypotheses, 0);
+  EXPECT_EQ(hurried.relocalize(two).hypotheses, 0);
+  EXPECT_EQ(hurried.relocalize(one, {}, gravity).hypotheses, 0);
+  EXPECT_TRUE(hurried.relocalize(two).budget_exhausted);
 }
 
 TEST(ObjectRelocalizer, DeterministicAndThreadSafe) {

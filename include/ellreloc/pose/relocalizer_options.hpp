@@ -43,10 +43,14 @@ struct SearchOptions {
   /// Sample and hypothesis budgets, adaptive stopping and seed. The Exhaustive sampler
   /// enumerates every triplet: only max_hypotheses and max_time_ms bound it.
   RansacOptions budget;
-  /// A machine-independent bound on the work: max_hypotheses shrinks to this many overlaps
-  /// over (map objects x usable observations), but never below min_hypotheses. 0: no bound.
+  /// A machine-independent bound on the work: scoring a hypothesis costs up to one overlap per
+  /// (map object, usable observation) pair, so max_hypotheses shrinks to this many overlaps
+  /// over that product. 0: no bound.
   long max_overlap_evaluations = 40000000;
-  long min_hypotheses = 1000;
+  /// At most this many (observation, candidate object) pairs are formed, so that memory stays
+  /// bounded (about 100 bytes a pair) whatever the frame and map: beyond it the least confident
+  /// observations are left out (RelocalizationResult::skipped says so).
+  long max_candidate_pairs = 1000000;
 
   SearchOptions() {
     budget.min_iterations = 50;
@@ -126,7 +130,9 @@ struct RelocalizerOptions {
     o.search.correct_centres = false;
     o.search.check_sample_overlap = false;
     o.search.budget.max_hypotheses = 1L << 40;
-    o.search.max_overlap_evaluations = 0;  // the baseline enumerates everything
+    // The baseline enumerates everything real frames offer (at most 4.3e7 overlaps on fr2_desk
+    // and fr3/long_office frames), but stays bounded on absurd input.
+    o.search.max_overlap_evaluations = 200000000;
     o.scoring.overlap = OverlapMeasure::BoxIoU;
     o.scoring.min_category_share = 1.0;  // equal (majority) categories only
     o.scoring.min_inliers = 3;
@@ -149,8 +155,8 @@ struct RelocalizerOptions {
       return "search.budget.max_time_ms is negative or not finite";
     if (!(search.budget.success_probability > 0 && search.budget.success_probability < 1))
       return "search.budget.success_probability is not in (0, 1)";
-    if (search.max_overlap_evaluations < 0 || search.min_hypotheses < 0)
-      return "search.max_overlap_evaluations or search.min_hypotheses is negative";
+    if (search.max_overlap_evaluations < 0) return "search.max_overlap_evaluations is negative";
+    if (search.max_candidate_pairs < 1) return "search.max_candidate_pairs is below 1";
     if (!(scoring.min_overlap >= 0 && scoring.min_overlap <= 1)) return "scoring.min_overlap is not in [0, 1]";
     if (!(finite(scoring.unmatched_cost) && scoring.unmatched_cost >= 0))
       return "scoring.unmatched_cost is negative or not finite";

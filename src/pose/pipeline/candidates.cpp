@@ -5,35 +5,72 @@
 
 namespace ellreloc::pipeline {
 
+namespace {
+
+/// The label share through which map object m may be observation o, or a negative number when
+/// it may not (another category, below the options' share, or an unusable object).
+double candidateShare(const Observation& o, const MapObject& m, const ScoringOptions& options) {
+  const double share =
+      m.category == o.category ? std::max(m.categoryShare(o.category), 0.5) : m.categoryShare(o.category);
+  if (!mapObjectUsable(m) || !(share >= std::min(options.min_category_share, 0.5) &&
+                               (m.category == o.category || share >= options.min_category_share)))
+    return -1.0;
+  return share;
+}
+
+}  // namespace
+
 Candidates collectCandidates(const std::vector<Observation>& observations, const ObjectMap& map,
-                             const ScoringOptions& options, std::vector<std::pair<int, std::string>>* skipped) {
+                             const ScoringOptions& options, long max_pairs,
+                             std::vector<std::pair<int, std::string>>* skipped) {
   Candidates c;
   c.usable.assign(observations.size(), 0);
   c.of_observation.resize(observations.size());
+  // Candidate counts first, so that no pair beyond max_pairs is ever stored: when the frame
+  // and map would give more, the most confident observations (detection score, then order)
+  // keep their candidates.
+  std::vector<long> count(observations.size(), 0);
+  std::vector<size_t> order;
   for (size_t i = 0; i < observations.size(); ++i) {
     const Observation& o = observations[i];
     if (!o.ellipse.isValid() || !o.box.isValid() || !std::isfinite(o.score)) {
       skipped->emplace_back(static_cast<int>(i), "invalid ellipse, box or score (NaN, infinite or empty)");
       continue;
     }
+    for (const MapObject& m : map.objects) count[i] += candidateShare(o, m, options) >= 0.0;
+    if (count[i] == 0) {
+      skipped->emplace_back(static_cast<int>(i), "no map object of category " + std::to_string(o.category));
+      continue;
+    }
+    order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return observations[a].score > observations[b].score; });
+  long total = 0;
+  for (size_t i : order) {
+    if (total + count[i] > max_pairs) {
+      skipped->emplace_back(static_cast<int>(i), "beyond the bound of " + std::to_string(max_pairs) +
+                                                     " candidate pairs (search.max_candidate_pairs)");
+      continue;
+    }
+    total += count[i];
+    c.usable[i] = 1;
+    ++c.num_usable;
+  }
+  c.pairs.reserve(static_cast<size_t>(total));
+  for (size_t i = 0; i < observations.size(); ++i) {
+    if (!c.usable[i]) continue;
+    const Observation& o = observations[i];
     for (size_t j = 0; j < map.objects.size(); ++j) {
       const MapObject& m = map.objects[j];
-      const double share =
-          m.category == o.category ? std::max(m.categoryShare(o.category), 0.5) : m.categoryShare(o.category);
-      if (!mapObjectUsable(m) || !(share >= std::min(options.min_category_share, 0.5) &&
-                                   (m.category == o.category || share >= options.min_category_share)))
-        continue;
+      const double share = candidateShare(o, m, options);
+      if (share < 0.0) continue;
       c.of_observation[i].push_back(static_cast<int>(j));
       // Likelier labels, surer detections and larger objects first: PROSAC order.
       c.pairs.push_back({static_cast<int>(i), static_cast<int>(j), share * o.score * std::cbrt(m.ellipsoid.volume())});
     }
-    if (c.of_observation[i].empty()) {
-      skipped->emplace_back(static_cast<int>(i), "no map object of category " + std::to_string(o.category));
-      continue;
-    }
-    c.usable[i] = 1;
-    ++c.num_usable;
   }
+  std::sort(skipped->begin(), skipped->end());
   std::stable_sort(c.pairs.begin(), c.pairs.end(),
                    [](const CandidatePair& a, const CandidatePair& b) { return a.quality > b.quality; });
   return c;

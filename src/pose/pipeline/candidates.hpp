@@ -27,8 +27,10 @@ struct Candidates {
   int num_usable = 0;
 };
 
-/// Observations that are invalid or have no candidate object go to `skipped` with the reason.
+/// Observations that are invalid, have no candidate object, or would take the pairs beyond
+/// max_pairs go to `skipped` (in observation order) with the reason.
 Candidates collectCandidates(const std::vector<Observation>& observations, const ObjectMap& map,
-                             const ScoringOptions& options, std::vector<std::pair<int, std::string>>* skipped);
+                             const ScoringOptions& options, long max_pairs,
+                             std::vector<std::pair<int, std::string>>* skipped);
 
 }  // namespace ellreloc::pipeline

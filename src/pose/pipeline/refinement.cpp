@@ -45,12 +45,14 @@ std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>
 }
 
 ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best, PoseScorer& scorer,
-                            const RefinementContext& context) {
+                            const RefinementContext& context, size_t max_refined) {
   ChosenPose best;
   best.pose = search_best;
   best.cost = scorer.cost(search_best, kReportIoUVertices);
+  size_t refined = 0;
   for (const ScoredPose& h : pool.entries()) {
     if (h.cost > pool.best().cost + context.options.refinement.cost_margin) break;  // ascending costs
+    if (refined++ == max_refined) break;
     ChosenPose candidate = refineRounds(h.pose, scorer, context);
     if (candidate.cost < best.cost || (candidate.refined && candidate.cost <= best.cost)) {
       best.pose = candidate.pose;

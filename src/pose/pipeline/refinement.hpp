@@ -33,10 +33,11 @@ struct RefinementContext {
 /// explains the observations better (a refined pose often brings more objects into overlap).
 ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementContext& context);
 
-/// Starts from `search_best` (the search's best pose) and refines every pooled hypothesis
-/// within refinement.cost_margin of the pool's best; returns the lowest-cost result.
+/// Starts from `search_best` (the search's best pose) and refines the pooled hypotheses within
+/// refinement.cost_margin of the pool's best, at most `max_refined`, best first; returns the
+/// lowest-cost result.
 ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best, PoseScorer& scorer,
-                            const RefinementContext& context);
+                            const RefinementContext& context, size_t max_refined);
 
 /// Refines the chosen pose again with keypoints matched to map points; keeps the result when it
 /// still explains as many observations.

@@ -5,29 +5,22 @@
 
 namespace ellreloc::pipeline {
 
-namespace {
-
-/// The budgets of options.search for this frame.
-RansacOptions frameBudget(const SearchOptions& search, HypothesisSampler sampler, size_t num_objects, int num_usable) {
-  RansacOptions budget = search.budget;
-  // Scoring a hypothesis costs up to (map objects) x (usable observations) overlaps: a large map
-  // with many observations gets fewer hypotheses, so that the worst case stays bounded.
+FrameBudget frameBudget(const SearchOptions& search, size_t num_objects, int num_usable,
+                        std::chrono::steady_clock::time_point start) {
+  FrameBudget budget;
+  budget.max_hypotheses = search.budget.max_hypotheses;
+  budget.max_time_ms = search.budget.max_time_ms;
+  budget.start = start;
   if (search.max_overlap_evaluations > 0) {
-    const double per_hypothesis = static_cast<double>(num_objects) * static_cast<double>(num_usable);
-    const long affordable = static_cast<long>(static_cast<double>(search.max_overlap_evaluations) / per_hypothesis);
-    budget.max_hypotheses = std::min(budget.max_hypotheses, std::max(affordable, search.min_hypotheses));
-  }
-  if (sampler == HypothesisSampler::Exhaustive) {  // try everything: only hypotheses and time bound it
-    budget.min_iterations = std::numeric_limits<int>::max() / 2;
-    budget.max_iterations = std::numeric_limits<int>::max() / 2;
+    const double per_hypothesis = std::max(1.0, static_cast<double>(num_objects) * static_cast<double>(num_usable));
+    const double affordable = static_cast<double>(search.max_overlap_evaluations) / per_hypothesis;
+    budget.max_hypotheses = std::min(budget.max_hypotheses, static_cast<long>(affordable));
   }
   return budget;
 }
 
-}  // namespace
-
-void searchTriplets(const HypothesisEstimator& estimator, const RelocalizerOptions& options, size_t num_objects,
-                    int num_usable, HypothesisPool* pool, SearchOutcome* outcome) {
+void searchTriplets(const HypothesisEstimator& estimator, const RelocalizerOptions& options, const FrameBudget& frame,
+                    HypothesisPool* pool, SearchOutcome* outcome) {
   const int n = static_cast<int>(estimator.numData());
   HypothesisSampler sampler = options.search.sampler;
   if (sampler == HypothesisSampler::Auto) {
@@ -35,7 +28,16 @@ void searchTriplets(const HypothesisEstimator& estimator, const RelocalizerOptio
     sampler = triplets <= static_cast<double>(options.search.max_exhaustive_triplets) ? HypothesisSampler::Exhaustive
                                                                                       : HypothesisSampler::Prosac;
   }
-  const RansacOptions budget = frameBudget(options.search, sampler, num_objects, num_usable);
+  RansacOptions budget = options.search.budget;
+  budget.max_hypotheses = frame.max_hypotheses;
+  if (frame.max_time_ms > 0.0) {  // what the frame's clock has left (0 would mean no bound)
+    budget.max_time_ms = frame.max_time_ms - frame.elapsedMs();
+    if (budget.max_time_ms <= 0.0) budget.max_hypotheses = 0, budget.max_time_ms = 1e-9;
+  }
+  if (sampler == HypothesisSampler::Exhaustive) {  // try everything: only hypotheses and time bound it
+    budget.min_iterations = std::numeric_limits<int>::max() / 2;
+    budget.max_iterations = std::numeric_limits<int>::max() / 2;
+  }
   const auto remember = [pool](const PoseHypothesis& h, double cost, int) { pool->offer(h.pose, cost); };
   PoseHypothesis best;
   RansacStats stats;
@@ -71,20 +73,31 @@ void searchTriplets(const HypothesisEstimator& estimator, const RelocalizerOptio
 
 void searchFewObjects(const HypothesisEstimator& estimator, const Candidates& candidates,
                       const RelocalizerOptions& options, const std::optional<GravityPrior>& gravity,
-                      HypothesisPool* pool, SearchOutcome* outcome) {
+                      const FrameBudget& budget, HypothesisPool* pool, SearchOutcome* outcome) {
   const std::vector<CandidatePair>& pairs = candidates.pairs;
   const long max_calls = options.few_objects.max_pair_hypotheses;
+  const long max_poses = std::max(0L, budget.max_hypotheses - outcome->hypotheses);
   std::vector<PoseHypothesis> poses;
   long calls = 0;
-  for (size_t i = 0; i < pairs.size() && calls < max_calls; ++i)
-    for (size_t j = i + 1; j < pairs.size() && calls < max_calls; ++j) {
+  // A solver call costs far more than a clock read: the clock is read before each.
+  const auto more = [&] {
+    if (calls >= max_calls || static_cast<long>(poses.size()) >= max_poses) return false;
+    if (budget.timeUp()) return outcome->budget_exhausted = true, false;
+    return true;
+  };
+  for (size_t i = 0; i < pairs.size() && more(); ++i)
+    for (size_t j = i + 1; j < pairs.size() && more(); ++j) {
       if (pairs[i].observation == pairs[j].observation || pairs[i].object == pairs[j].object) continue;
       ++calls;
       estimator.fromTwoPairs(static_cast<int>(i), static_cast<int>(j), gravity, &poses);
     }
   if (gravity && candidates.num_usable == 1)
-    for (size_t i = 0; i < pairs.size() && calls < max_calls; ++i, ++calls)
+    for (size_t i = 0; i < pairs.size() && more(); ++i, ++calls)
       estimator.fromOnePair(static_cast<int>(i), *gravity, &poses);
+  if (static_cast<long>(poses.size()) > max_poses) {  // a solver call may give several
+    poses.resize(static_cast<size_t>(max_poses));
+    outcome->budget_exhausted = true;
+  }
   // They compete with the triplets' poses in the same score.
   for (const PoseHypothesis& h : poses) {
     int inliers = 0;
