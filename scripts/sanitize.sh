@@ -22,7 +22,7 @@ if [ "$what" = asan ] || [ "$what" = all ]; then
   # the real-data regressions (fr2_desk: 198 relocalizations, 90 s under ASan; fr3: a 646-frame
   # box map; the CLI paths they take are covered by the other CLI tests).
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-    ctest --test-dir build-asan --output-on-failure -j "$jobs" -E "packaging.consumer|Cli.Fr2Desk|Cli.Fr3Boxes"
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" -E "packaging.consumer|Cli.Fr2Desk|Cli.Fr3Boxes|Acceptance.NoPose"
 fi
 
 if [ "$what" = tsan ] || [ "$what" = all ]; then

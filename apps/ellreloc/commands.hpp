@@ -9,6 +9,7 @@
 #include "ellreloc/core/evaluation.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/observe/observe.hpp"
+#include "ellreloc/pose/relocalizer_options.hpp"
 
 namespace CLI {
 class App;
@@ -66,7 +67,9 @@ struct RelocalizeArgs {
   bool use_points = false;  ///< refine with the frames' keypoints matched to the map's points
   std::string points;       ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;
-  double max_time_ms = 0.0;               ///< wall-clock budget of each frame's search; 0: none
+  double max_time_ms = 0.0;  ///< wall-clock budget of each frame's search; 0: none
+  double min_evidence = AcceptanceOptions().min_evidence;
+  bool accept_all = false;
   std::vector<double> camera_up, map_up;  ///< a gravity prior for every frame, when both are given
   double gravity_sigma_deg = 2.0;
 };

@@ -52,6 +52,13 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
                 "machine)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e9));
+  r->add_option("--min-evidence", a.min_evidence,
+                "report a pose only when its matches' overlaps, less 0.5 per observation left unexplained, sum to "
+                "this (ours; frames of random boxes pass 1% of the time at the default)")
+      ->capture_default_str()
+      ->check(CLI::Range(-1e6, 1e6));
+  r->add_flag("--accept-all", a.accept_all,
+              "report every pose found, however weakly supported (as the oa-slam method does)");
   auto* camera_up = r->add_option("--camera-up", a.camera_up,
                                   "gravity prior: the up direction in the camera frame (x right, y down, z forward), "
                                   "for a camera at a fixed tilt, e.g. 0,-1,0 for a level camera")
@@ -156,6 +163,10 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
     throw Error("--method: unknown method '" + a.method + "' (ours, oa-slam)");
   }
   options.search.budget.max_time_ms = a.max_time_ms;
+  if (a.method == "ours") {
+    options.acceptance.min_evidence = a.min_evidence;
+    options.acceptance.enabled = !a.accept_all;
+  }
   if (!a.envelope.empty()) {
     std::vector<Pose> keyframes;
     for (const io::StampedPose& p : io::readTumTrajectory(a.envelope)) keyframes.push_back(p.pose);
@@ -194,6 +205,7 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                       {"inliers", r.inliers.size()},
                       {"score", r.cost},
                       {"mean_overlap", r.mean_overlap},
+                      {"evidence", r.evidence},
                       {"hypotheses", r.hypotheses},
                       {"budget_exhausted", r.budget_exhausted},
                       {"time_ms", r.time_ms}};

@@ -1,6 +1,8 @@
 #include "ellreloc/pose/object_relocalizer.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "pipeline/candidates.hpp"
 #include "pipeline/hypothesis_estimator.hpp"
@@ -23,18 +25,24 @@ const char* toString(RelocalizationStatus s) {
       return "no consistent hypothesis";
     case RelocalizationStatus::InvalidInput:
       return "invalid input";
+    case RelocalizationStatus::LowEvidence:
+      return "low evidence";
   }
   return "unknown";
 }
 
 namespace {
 
-/// The matches of a pose as the result's correspondences, and their mean overlap.
-void reportMatches(const std::vector<ObjectCorrespondence>& matches, RelocalizationResult* result) {
+/// The matches of a pose as the result's correspondences, their mean overlap and the evidence
+/// they give among `usable` observations.
+void reportMatches(const std::vector<ObjectCorrespondence>& matches, int usable, const AcceptanceOptions& acceptance,
+                   RelocalizationResult* result) {
   double sum = 0.0;
   for (const ObjectCorrespondence& m : matches) sum += m.overlap;
   result->inliers = matches;
   result->mean_overlap = matches.empty() ? 0.0 : sum / static_cast<double>(matches.size());
+  const int unexplained = std::max(0, usable - static_cast<int>(matches.size()));
+  result->evidence = sum - acceptance.unexplained_penalty * unexplained;
 }
 
 /// Keypoints whose index names a finite map point, as the refiner's point matches.
@@ -81,7 +89,7 @@ RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
   std::vector<ObjectCorrespondence> matches;
   result.cost = scorer.cost(pose, kReportIoUVertices, &matches);
-  reportMatches(matches, &result);
+  reportMatches(matches, candidates.num_usable, options_.acceptance, &result);
   const int needed = std::min(options_.scoring.min_inliers, std::max(candidates.num_usable, 1));
   const bool enough = static_cast<int>(matches.size()) >= needed;
   result.status = enough ? RelocalizationStatus::Success : RelocalizationStatus::NoConsistentHypothesis;
@@ -168,12 +176,18 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   result.pose = chosen.pose;
   result.cost = chosen.cost;
   result.refined = chosen.refined;
-  reportMatches(chosen.matches, &result);
+  reportMatches(chosen.matches, usable, options_.acceptance, &result);
   const int min_inliers = usable == 1 ? 1 : options_.scoring.min_inliers;  // one observation needs gravity (above)
   if (static_cast<int>(chosen.matches.size()) < min_inliers)
     return finish(RelocalizationStatus::NoConsistentHypothesis,
                   "best pose explains " + std::to_string(chosen.matches.size()) + " observation(s); " +
                       std::to_string(min_inliers) + " needed");
+  if (options_.acceptance.enabled && result.evidence < options_.acceptance.min_evidence) {
+    char reason[160];
+    std::snprintf(reason, sizeof reason, "evidence %.2f below %.2f: %zu of %d usable observations explained",
+                  result.evidence, options_.acceptance.min_evidence, chosen.matches.size(), usable);
+    return finish(RelocalizationStatus::LowEvidence, reason);
+  }
   return finish(RelocalizationStatus::Success, "");
 }
 

@@ -14,7 +14,8 @@
 ///                observation left out, so a wrong or missed detection costs at most a constant
 ///   refine       the pooled hypotheses refined with the Wasserstein refiner on all their
 ///                matches, re-matched and refined again while observations join
-///   result       the lowest-cost pose, its matches and statistics
+///   result       the lowest-cost pose, its matches and statistics; LowEvidence instead of
+///                Success when the matches support it too weakly (acceptance)
 /// A gravity prior drops every hypothesis whose tilt disagrees with it and lets a single
 /// observation give poses.
 
@@ -36,6 +37,10 @@ enum class RelocalizationStatus {
   NotEnoughObservations,   ///< too few usable observations with a candidate object (see RelocalizerOptions)
   NoConsistentHypothesis,  ///< no pose explains at least scoring.min_inliers observations
   InvalidInput,            ///< invalid intrinsics, gravity prior or options
+  /// A pose was found but the observations support it too weakly (RelocalizationResult::evidence
+  /// below acceptance.min_evidence): frames of random boxes get such poses. `pose` and `inliers`
+  /// hold it, for a host that can check it otherwise (e.g. with points).
+  LowEvidence,
 };
 
 const char* toString(RelocalizationStatus s);
@@ -53,8 +58,11 @@ struct RelocalizationResult {
   std::string reason;  ///< human-readable, one line
   Pose pose;           ///< valid when status == Success
   std::vector<ObjectCorrespondence> inliers;
-  double cost = 0.0;                                 ///< truncated overlap cost of the pose (lower is better)
-  double mean_overlap = 0.0;                         ///< over the inliers
+  double cost = 0.0;          ///< truncated overlap cost of the pose (lower is better)
+  double mean_overlap = 0.0;  ///< over the inliers
+  /// Sum of the inliers' overlaps minus half a point per usable observation left unexplained
+  /// (AcceptanceOptions).
+  double evidence = 0.0;
   std::vector<std::pair<int, std::string>> skipped;  ///< observations not used, with the reason
   long hypotheses = 0;
   int iterations = 0;

@@ -111,12 +111,25 @@ struct RefinementStageOptions {
   RefinerOptions refiner;
 };
 
+/// Whether the observations support the chosen pose enough to report it. The evidence of a
+/// pose is the sum of its matches' overlaps minus `unexplained_penalty` per usable observation
+/// it leaves unexplained. Poses below `min_evidence` get LowEvidence, not Success: calibrated on
+/// frames of random boxes of the maps' categories and on frames of one scene against another
+/// scene's map (docs/reliability.md), of which 1% pass; at 2.3 a pose needs at least three
+/// matches, so frames with one or two objects need a host's own check (acceptance off).
+struct AcceptanceOptions {
+  bool enabled = true;
+  double min_evidence = 2.3;
+  double unexplained_penalty = 0.5;
+};
+
 struct RelocalizerOptions {
   SearchOptions search;
   ScoringOptions scoring;
   FewObjectSearchOptions few_objects;
   GravityOptions gravity;
   RefinementStageOptions refinement;
+  AcceptanceOptions acceptance;
   /// Where the camera can be (camera_envelope.hpp, e.g. from the mapping keyframes): poses
   /// outside are never hypotheses. None: anywhere.
   std::optional<CameraEnvelope> envelope;
@@ -141,6 +154,7 @@ struct RelocalizerOptions {
     o.few_objects.enabled = false;
     o.refinement.enabled = false;
     o.refinement.top_k = 1;
+    o.acceptance.enabled = false;  // OA-SLAM reports every pose it finds
     return o;
   }
 
@@ -178,6 +192,9 @@ struct RelocalizerOptions {
       return "refinement.refiner has a non-positive or non-finite scale or weight";
     if (r.max_iterations < 0 || !(r.function_tolerance >= 0))
       return "refinement.refiner has a negative tolerance or count";
+    if (!std::isfinite(acceptance.min_evidence) ||
+        !(std::isfinite(acceptance.unexplained_penalty) && acceptance.unexplained_penalty >= 0))
+      return "acceptance.min_evidence is not finite or acceptance.unexplained_penalty is negative";
     if (envelope && !envelope->isValid())
       return "envelope has a non-unit or non-finite up, or an empty or non-finite range";
     return "";

@@ -1,0 +1,100 @@
+// The acceptance test (AcceptanceOptions): frames that hold no evidence of the map get no pose.
+// Null frames are independent of the threshold's calibration data (other seeds, other scenes).
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/map.hpp"
+#include "ellreloc/observe/observe.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+#include "fixtures/data_dir.hpp"
+
+using namespace ellreloc;
+
+namespace {
+
+/// Box observations of every detection of each frame.
+std::vector<std::vector<Observation>> boxObservations(const std::vector<DetectionFrame>& frames, const Intrinsics& K) {
+  std::vector<std::vector<Observation>> out;
+  for (const DetectionFrame& f : frames) {
+    out.emplace_back();
+    for (const Detection& d : f.detections)
+      if (auto o = observationFromBox(d.category_id, d.score, d.bbox, K.width, K.height)) out.back().push_back(*o);
+  }
+  return out;
+}
+
+/// The frames with each box moved to a uniformly random place and given the size of a random
+/// box of the sequence: the categories and box sizes of real frames, no geometry.
+std::vector<DetectionFrame> randomBoxes(std::vector<DetectionFrame> frames, const Intrinsics& K, uint32_t seed) {
+  std::vector<Box> boxes;
+  for (const DetectionFrame& f : frames)
+    for (const Detection& d : f.detections) boxes.push_back(d.bbox);
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<size_t> pick(0, boxes.size() - 1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (DetectionFrame& f : frames)
+    for (Detection& d : f.detections) {
+      const Box& b = boxes[pick(rng)];
+      const double x = u(rng) * std::max(0.0, K.width - b.width()), y = u(rng) * std::max(0.0, K.height - b.height());
+      d.bbox = Box(x, y, x + b.width(), y + b.height());
+    }
+  return frames;
+}
+
+/// Frames given a pose: reported (Success) and found at all (Success or LowEvidence).
+struct Posed {
+  int reported = 0, found = 0;
+};
+
+Posed posed(const ObjectRelocalizer& reloc, const std::vector<std::vector<Observation>>& frames) {
+  Posed n;
+  for (const auto& observations : frames) {
+    const RelocalizationStatus s = reloc.relocalize(observations).status;
+    n.reported += s == RelocalizationStatus::Success;
+    n.found += s == RelocalizationStatus::Success || s == RelocalizationStatus::LowEvidence;
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST(Acceptance, NoPoseFromRandomBoxesOrFromAnotherScene) {
+  const std::string fr2 = test::dataPath("tum_fr2_desk"), s11 = test::dataPath("independent_synth/office_s11");
+  const Intrinsics K = io::readCamera(fr2 + "/camera.yaml");
+  const ObjectMap desk = io::readMap(fr2 + "/map.json");
+  const std::vector<DetectionFrame> keyframes = io::readDetections(fr2 + "/keyframes.detections.json");
+  const std::vector<DetectionFrame> office = io::readDetections(s11 + "/query.detections.json");
+  const ObjectRelocalizer ours(desk, K);
+
+  // Random boxes of the desk's categories, and the other scene's frames, against the desk's map:
+  // without the test nearly every frame gets a pose; with it, a few.
+  std::vector<DetectionFrame> every_other;
+  for (size_t i = 0; i < keyframes.size(); i += 2) every_other.push_back(keyframes[i]);
+  const auto random = boxObservations(randomBoxes(every_other, K, 2024), K);
+  const Posed from_random = posed(ours, random), from_other_scene = posed(ours, boxObservations(office, K));
+  EXPECT_GE(from_random.found, 80);       // of 99: measured 91
+  EXPECT_GE(from_other_scene.found, 90);  // of 100: measured 100
+  // Measured 0 and 5: the office scene's many chairs, monitors and keyboards against the desk's
+  // map is the hardest of the null sets of docs/reliability.md (1% overall).
+  EXPECT_LE(from_random.reported, 5);
+  EXPECT_LE(from_other_scene.reported, 7);
+
+  // The real keyframes keep most of their poses: the evidence of a true pose is far above it.
+  const Posed real = posed(ours, boxObservations(every_other, K));
+  EXPECT_GE(real.reported, 62);  // measured 67 of 99 (91 without the test)
+
+  // A withheld pose says why and keeps the pose for a host's own check.
+  for (const auto& observations : random) {
+    const RelocalizationResult r = ours.relocalize(observations);
+    if (r.status != RelocalizationStatus::LowEvidence) continue;
+    EXPECT_LT(r.evidence, ours.options().acceptance.min_evidence);
+    EXPECT_NE(r.reason.find("evidence"), std::string::npos);
+    EXPECT_TRUE(r.pose.isValid());
+    EXPECT_FALSE(r.inliers.empty());
+    break;
+  }
+}
