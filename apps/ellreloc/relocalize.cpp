@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <map>
@@ -162,6 +163,9 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
   } else if (a.method != "ours") {
     throw Error("--method: unknown method '" + a.method + "' (ours, oa-slam)");
   }
+  // CLI11's range checks let NaN through.
+  if (!std::isfinite(a.max_time_ms)) throw Error("--max-time-ms: expected a number of milliseconds, not NaN");
+  if (!std::isfinite(a.min_evidence)) throw Error("--min-evidence: expected a number, not NaN");
   options.search.budget.max_time_ms = a.max_time_ms;
   if (a.method == "ours") {
     options.acceptance.min_evidence = a.min_evidence;
@@ -175,6 +179,7 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
     options.envelope = CameraEnvelope::fromKeyframes(keyframes, up);
     if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
   }
+  if (const std::string problem = options.validate(); !problem.empty()) throw Error("options: " + problem);
   return options;
 }
 

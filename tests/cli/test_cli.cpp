@@ -319,6 +319,10 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                            "/keyframes.detections.json --camera-up 0,0,0 --map-up 0,0,1"},
       {"camera up without map up",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --camera-up 0,-1,0"},
+      {"NaN time budget",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --max-time-ms nan"},
+      {"NaN evidence",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --min-evidence nan"},
       {"gravity sigma without directions",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --gravity-sigma 5"},
   };

@@ -1,4 +1,6 @@
 // The readers that take paths: camera YAML and JSON, TUM trajectories, association files.
+#include <cmath>
+
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/rgbd.hpp"
@@ -16,7 +18,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   const std::string txt = fuzz::writeScratch(data, size, ".txt");
   try {
-    for (const io::StampedPose& p : io::readTumTrajectory(txt)) FUZZ_CHECK(p.pose.isValid());
+    const std::vector<io::StampedPose> poses = io::readTumTrajectory(txt);
+    for (const io::StampedPose& p : poses) FUZZ_CHECK(p.pose.isValid() && std::isfinite(p.timestamp));
+    // What was read is written back with the same timestamp texts, and reads back the same.
+    const std::string again = fuzz::writeScratch(nullptr, 0, ".out.txt");
+    io::writeTumTrajectory(again, poses);
+    const std::vector<io::StampedPose> back = io::readTumTrajectory(again);
+    FUZZ_CHECK(back.size() == poses.size());
+    for (size_t i = 0; i < back.size(); ++i)
+      FUZZ_CHECK(back[i].stamp == poses[i].stamp && back[i].timestamp == poses[i].timestamp);
   } catch (const Error&) {
   }
   try {
