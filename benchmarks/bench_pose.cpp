@@ -1,7 +1,6 @@
 // Pose refinement and relocalization, microseconds per call.
 // Run: ./build/benchmarks/bench_pose --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
-
 #include <sys/resource.h>
 
 #include <random>

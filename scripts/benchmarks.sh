@@ -34,7 +34,9 @@ table() {  # NAME COMMAND...: an accuracy binary that prints a Markdown table
 gbench core bench_core
 gbench p3p bench_p3p
 gbench refiner bench_pose 'Refine'
-gbench relocalize_room bench_pose 'Relocalize|WorstCase'
+gbench relocalize_room bench_pose 'Relocalize47|WorstCase'
+gbench huge_frames bench_pose 'HugeFrame'
+gbench real_frames bench_real_frames
 gbench observe bench_observe
 gbench sim bench_sim
 gbench mapping bench_mapping

@@ -177,14 +177,14 @@ TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
   }
   s.observations.resize(50);
   RelocalizerOptions hypotheses_only;
-  hypotheses_only.search.budget.max_hypotheses = 300;
+  hypotheses_only.search.budget.max_hypotheses = 100;
   const RelocalizationResult a = ObjectRelocalizer(s.map, K, hypotheses_only).relocalize(s.observations);
-  EXPECT_LE(a.hypotheses, 300 + 4);  // the last triplet's P3P solutions may finish
+  EXPECT_LE(a.hypotheses, 100 + 4);  // the last triplet's P3P solutions may finish
   EXPECT_TRUE(a.budget_exhausted);
-  RelocalizerOptions work_only;  // the machine-independent bound: 3e6 overlaps = 300 hypotheses here
-  work_only.search.max_overlap_evaluations = 200L * 50 * 300;
+  RelocalizerOptions work_only;  // the machine-independent bound: 1e6 overlaps = 100 hypotheses here
+  work_only.search.max_overlap_evaluations = 200L * 50 * 100;
   const RelocalizationResult w = ObjectRelocalizer(s.map, K, work_only).relocalize(s.observations);
-  EXPECT_LE(w.hypotheses, 300 + 4);
+  EXPECT_LE(w.hypotheses, 100 + 4);
   EXPECT_TRUE(w.budget_exhausted);
   RelocalizerOptions time_only;
   time_only.search.max_overlap_evaluations = 0;
@@ -194,16 +194,17 @@ TEST(ObjectRelocalizer, BudgetsBoundTheWorkOnHugeAmbiguousInput) {
   EXPECT_TRUE(b.budget_exhausted);  // stopped by the clock, not by running out of triplets
   EXPECT_LT(b.hypotheses, 1L << 30);
   // The OA-SLAM preset's exhaustive search is bounded the same way (by default at 2e8 overlaps,
-  // 20,000 hypotheses here; 300 in this test, for time).
+  // 20,000 hypotheses here; 100 in this test, for time).
   RelocalizerOptions preset = RelocalizerOptions::oaSlam();
   EXPECT_EQ(preset.search.max_overlap_evaluations, 200000000L);
-  preset.search.max_overlap_evaluations = 200L * 50 * 300;
+  preset.search.max_overlap_evaluations = 200L * 50 * 100;
   const RelocalizationResult p = ObjectRelocalizer(s.map, K, preset).relocalize(s.observations);
-  EXPECT_LE(p.hypotheses, 300 + 4);
+  EXPECT_LE(p.hypotheses, 100 + 4);
   EXPECT_TRUE(p.budget_exhausted);
   // No pair table beyond its bound: the least confident observations are left out, named.
   RelocalizerOptions few_pairs;
   few_pairs.search.max_candidate_pairs = 200 * 10;  // every object is a candidate: 10 observations
+  few_pairs.search.budget.max_hypotheses = 100;
   const RelocalizationResult c = ObjectRelocalizer(s.map, K, few_pairs).relocalize(s.observations);
   EXPECT_EQ(c.skipped.size(), 40u);
   for (const auto& [index, reason] : c.skipped) EXPECT_NE(reason.find("max_candidate_pairs"), std::string::npos);

@@ -1,0 +1,104 @@
+// Relocalization time on real frames, one thread: the median and 90th percentile per frame, ours
+// beside the OA-SLAM preset in the same run.
+//   fr2   every fr2_desk keyframe (198) against the real GOReloc map
+//   fr3   every 10th frame of the odd frames of the fr3/long_office first half (129) against a map
+//         built from its even frames by the boxes mapper (motion-capture poses)
+// Run: ./build/benchmarks/bench_real_frames --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/map.hpp"
+#include "ellreloc/io/trajectory.hpp"
+#include "ellreloc/mapping/mapper.hpp"
+#include "ellreloc/observe/observe.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+
+using namespace ellreloc;
+
+namespace {
+
+const std::string kData = ELLRELOC_BENCH_DATA_DIR;
+
+struct RealSet {
+  Intrinsics K;
+  ObjectMap map;
+  std::vector<std::vector<Observation>> frames;
+};
+
+std::vector<Observation> observeFrame(const DetectionFrame& f, const Intrinsics& K) {
+  std::vector<Observation> out;
+  for (const Detection& d : f.detections)
+    if (const ObserveResult r = observeDetection(d, K.width, K.height); r.observation) out.push_back(*r.observation);
+  return out;
+}
+
+RealSet fr2() {
+  RealSet s;
+  const std::string d = kData + "/tum_fr2_desk";
+  s.K = io::readCamera(d + "/camera.yaml");
+  s.map = io::readMap(d + "/map.json");
+  for (const DetectionFrame& f : io::readDetections(d + "/keyframes.detections.json"))
+    s.frames.push_back(observeFrame(f, s.K));
+  return s;
+}
+
+RealSet fr3() {
+  RealSet s;
+  const std::string d = kData + "/tum_fr3_office_first_half";
+  s.K = io::readCamera(d + "/camera.yaml");
+  const std::vector<io::StampedPose> truth = io::readTumTrajectory(d + "/groundtruth.txt");
+  const std::vector<DetectionFrame> frames = io::readDetections(d + "/detections.json");
+  MapperOptions options;
+  options.mode = MappingMode::Boxes;
+  Mapper mapper(s.K, options);
+  for (size_t i = 0; i < frames.size(); i += 2)
+    if (const auto k = io::findNearest(truth, *frames[i].timestamp()))
+      mapper.addKeyframe(truth[*k].pose, frames[i].detections);
+  mapper.finish();
+  s.map = mapper.map();
+  for (size_t i = 1; i < frames.size(); i += 10) s.frames.push_back(observeFrame(frames[i], s.K));
+  return s;
+}
+
+const RealSet& realSet(int which) {
+  static const std::map<int, RealSet> sets = {{0, fr2()}, {1, fr3()}};
+  return sets.at(which);
+}
+
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5)];
+}
+
+/// One frame per iteration, every frame once per repetition; the counters give the median and
+/// the 90th percentile of the frames' times. state.range(0): the OA-SLAM preset.
+void relocalizeEveryFrame(benchmark::State& state, const RealSet& set) {
+  const ObjectRelocalizer reloc(set.map, set.K, state.range(0) ? RelocalizerOptions::oaSlam() : RelocalizerOptions());
+  std::vector<double> times;
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(reloc.relocalize(set.frames[i]));
+    times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    i = (i + 1) % set.frames.size();
+  }
+  state.counters["median_ms"] = percentile(times, 0.5);
+  state.counters["p90_ms"] = percentile(times, 0.9);
+}
+
+void BM_Fr2Keyframes(benchmark::State& state) { relocalizeEveryFrame(state, realSet(0)); }
+BENCHMARK(BM_Fr2Keyframes)->ArgName("oaslam")->Arg(0)->Arg(1)->Iterations(198)->Unit(benchmark::kMillisecond);
+
+void BM_Fr3Frames(benchmark::State& state) { relocalizeEveryFrame(state, realSet(1)); }
+BENCHMARK(BM_Fr3Frames)->ArgName("oaslam")->Arg(0)->Arg(1)->Iterations(129)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
