@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -67,9 +66,14 @@ RealSet fr3() {
   return s;
 }
 
+/// Loaded (and for fr3 mapped) on first use only.
 const RealSet& realSet(int which) {
-  static const std::map<int, RealSet> sets = {{0, fr2()}, {1, fr3()}};
-  return sets.at(which);
+  if (which == 0) {
+    static const RealSet set = fr2();
+    return set;
+  }
+  static const RealSet set = fr3();
+  return set;
 }
 
 double percentile(std::vector<double> v, double p) {

@@ -1,11 +1,10 @@
-#include "ellreloc/core/distances.hpp"
-
-#include "fixtures/random_geometry.hpp"
-
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <limits>
+
+#include "ellreloc/core/distances.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;
@@ -157,6 +156,29 @@ TEST(EllipseIoU, SpecialCases) {
   EXPECT_NEAR(ellipseIoU(h, v), iouRaster(h, v, 4000), 1e-3);
   EXPECT_EQ(ellipseIoU(a, Ellipse({100, 100}, {0, 20}, 0.3)), 0.0);
   EXPECT_EQ(ellipseIoU(a, Ellipse({std::nan(""), 100}, {10, 20}, 0.3)), 0.0);
+}
+
+// The bound the relocalizer's scoring uses to skip pairs: never below the IoU it stands for
+// (at both polygon sizes in use), and tight enough to skip far-apart or mismatched pairs.
+TEST(EllipseIoU, UpperBoundHoldsAndPrunes) {
+  std::mt19937 rng(135);
+  int pruned = 0, pairs = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Ellipse a = test::randomEllipse(rng);
+    // Near pairs: the second centred within a few semi-axes of the first, of any size.
+    const Ellipse b(
+        a.center() + Eigen::Vector2d(test::uniform(rng, -3, 3), test::uniform(rng, -3, 3)) * a.axes().maxCoeff(),
+        a.axes().cwiseProduct(Eigen::Vector2d(test::uniform(rng, 0.1, 3), test::uniform(rng, 0.1, 3))),
+        test::uniform(rng, 0, M_PI));
+    for (int vertices : {32, 128}) {
+      const double iou = ellipseIoU(a, b, vertices), bound = ellipseIoUUpperBound(a, b, vertices);
+      ASSERT_GE(bound, iou - 1e-12) << i << " " << vertices;
+      if (vertices == 32) ++pairs, pruned += bound < 0.15;
+    }
+  }
+  EXPECT_GT(pruned, pairs / 4);
+  EXPECT_EQ(ellipseIoUUpperBound(Ellipse({0, 0}, {1, 1}, 0), Ellipse({10, 0}, {1, 1}, 0)), 0.0);
+  EXPECT_NEAR(ellipseIoUUpperBound(Ellipse({0, 0}, {2, 1}, 0), Ellipse({0, 0}, {2, 1}, 0)), 1.0, 1e-12);
 }
 
 TEST(BoxIoU, HandComputedAndDegenerate) {

@@ -107,6 +107,21 @@ inline double bhattacharyya(const Ellipse& a, const Ellipse& b) {
 
 namespace detail {
 
+/// What ellipseIoU's polygon of n vertices needs: cos and sin of its angular step, and the
+/// radius factor k that gives it the ellipse's area, (n/2) sin(2 pi/n) k^2 = pi. Computed once
+/// for the vertex counts in use (32 and 128).
+struct PolygonConstants {
+  double cs, sn, k;
+};
+inline PolygonConstants makePolygonConstants(int vertices) {
+  const double step = 2.0 * M_PI / vertices;
+  return {std::cos(step), std::sin(step), std::sqrt(M_PI / (0.5 * vertices * std::sin(step)))};
+}
+inline PolygonConstants polygonConstants(int vertices) {
+  static const PolygonConstants c32 = makePolygonConstants(32), c128 = makePolygonConstants(128);
+  return vertices == 32 ? c32 : vertices == 128 ? c128 : makePolygonConstants(vertices);
+}
+
 /// Signed area of (triangle origin, p, q) intersected with the unit disc.
 inline double triangleDiscArea(const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
   const double cross_pq = p(0) * q(1) - p(1) * q(0);
@@ -157,13 +172,12 @@ inline double ellipseIoU(const Ellipse& e1, const Ellipse& e2, int vertices = 12
   // x' = diag(1/a, 1/b) R^T (x - c) maps `big` onto the unit disc.
   const Eigen::Matrix2d to_disc = big.axes().cwiseInverse().asDiagonal() * big.rotation().transpose();
   const Eigen::Matrix2d small_shape = small.rotation() * small.axes().asDiagonal();
-  // Polygon radius scaled so its area is the ellipse's: (n/2) sin(2 pi/n) k^2 = pi.
-  const double step = 2.0 * M_PI / vertices;
-  const double k = std::sqrt(M_PI / (0.5 * vertices * std::sin(step)));
+  // Polygon radius scaled so its area is the ellipse's.
+  const detail::PolygonConstants polygon = detail::polygonConstants(vertices);
   const Eigen::Vector2d offset = to_disc * (small.center() - big.center());
-  const Eigen::Matrix2d shape = k * to_disc * small_shape;
+  const Eigen::Matrix2d shape = polygon.k * to_disc * small_shape;
   // Unit-circle points by repeated rotation: no sin/cos per vertex (drift ~1e-15 over n steps).
-  const double cs = std::cos(step), sn = std::sin(step);
+  const double cs = polygon.cs, sn = polygon.sn;
   Eigen::Vector2d unit(1.0, 0.0);
   const Eigen::Vector2d first = offset + shape * unit;
   Eigen::Vector2d prev = first;
@@ -178,6 +192,26 @@ inline double ellipseIoU(const Ellipse& e1, const Ellipse& e2, int vertices = 12
   const double inter = std::min(std::abs(inter_disc) * big.axes().prod(), small.area());
   const double uni = e1.area() + e2.area() - inter;
   return uni > 0.0 ? std::clamp(inter / uni, 0.0, 1.0) : 0.0;
+}
+
+/// An upper bound of ellipseIoU(e1, e2, vertices) from the areas and the bounding boxes alone
+/// (the smaller ellipse's box widened by the polygon's radius factor, as the polygon may reach
+/// beyond the ellipse): a few operations instead of one atan2 per vertex, to skip pairs that
+/// cannot reach a threshold.
+inline double ellipseIoUUpperBound(const Ellipse& e1, const Ellipse& e2, int vertices = 128) {
+  if (!e1.isValid() || !e2.isValid() || vertices < 3) return 0.0;
+  const double a1 = e1.area(), a2 = e2.area();
+  const Ellipse& small = a1 < a2 ? e1 : e2;
+  const Ellipse& big = a1 < a2 ? e2 : e1;
+  const double k = detail::polygonConstants(vertices).k;
+  const Box s = small.boundingBox(), b = big.boundingBox();
+  const double hx = 0.5 * k * s.width(), hy = 0.5 * k * s.height();
+  const Eigen::Vector2d c = small.center();
+  const double w = std::min(c(0) + hx, b.x2) - std::max(c(0) - hx, b.x1);
+  const double h = std::min(c(1) + hy, b.y2) - std::max(c(1) - hy, b.y1);
+  if (!(w > 0.0) || !(h > 0.0)) return 0.0;
+  const double inter = std::min(std::min(a1, a2), w * h);
+  return inter / (a1 + a2 - inter);
 }
 
 /// Level-set distance between two ellipses, after Zins et al. (IROS 2022, "Level set-based

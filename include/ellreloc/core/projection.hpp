@@ -67,18 +67,34 @@ struct Projection {
   explicit operator bool() const { return ok(); }
 };
 
-/// Projects an ellipsoid with a world->camera pose. The image is an ellipse exactly when the
-/// ellipsoid lies strictly in front of the camera's principal plane (z_c > 0 everywhere);
-/// every other case returns a status, never a NaN.
-inline Projection project(const Ellipsoid& ellipsoid, const Intrinsics& K, const Pose& pose) {
+/// An ellipsoid with what each of its projections needs, computed once: for projecting the same
+/// map object at many poses.
+struct ProjectableEllipsoid {
+  Ellipsoid ellipsoid;
+  Eigen::Matrix4d dual_quadric = Eigen::Matrix4d::Zero();
+  Eigen::Matrix3d shape = Eigen::Matrix3d::Zero();
+  bool valid = false;
+
+  ProjectableEllipsoid() = default;
+  explicit ProjectableEllipsoid(const Ellipsoid& e) : ellipsoid(e), valid(e.isValid()) {
+    if (!valid) return;
+    dual_quadric = e.dualQuadric();
+    shape = e.shapeMatrix();
+  }
+};
+
+/// project() for a prepared ellipsoid and the camera matrix P = projectionMatrix(K, pose) of a
+/// valid pose: the same result, bit for bit, without recomputing what does not change.
+inline Projection projectPrepared(const ProjectableEllipsoid& e, const Eigen::Matrix<double, 3, 4>& P,
+                                  const Pose& pose) {
   Projection out;
-  if (!ellipsoid.isValid() || !K.isValid() || !pose.isValid()) return out;
-  if (ellipsoid.contains(pose.center())) {
+  if (!e.valid) return out;
+  if (e.ellipsoid.contains(pose.center())) {
     out.status = ProjectionStatus::ContainsCamera;
     return out;
   }
   double near = 0.0, far = 0.0;
-  depthRange<double>(pose.rotation(), pose.translation(), ellipsoid.center(), ellipsoid.shapeMatrix(), &near, &far);
+  depthRange<double>(pose.rotation(), pose.translation(), e.ellipsoid.center(), e.shape, &near, &far);
   if (far <= 0.0) {
     out.status = ProjectionStatus::BehindCamera;
     return out;
@@ -87,15 +103,22 @@ inline Projection project(const Ellipsoid& ellipsoid, const Intrinsics& K, const
     out.status = ProjectionStatus::NotAnEllipse;
     return out;
   }
-  const Eigen::Matrix3d C = projectDualQuadric<double>(projectionMatrix(K, pose), ellipsoid.dualQuadric());
-  const std::optional<Ellipse> e = Ellipse::fromDualConic(C);
-  if (!e) {
+  const std::optional<Ellipse> ellipse = Ellipse::fromDualConic(projectDualQuadric<double>(P, e.dual_quadric));
+  if (!ellipse) {
     out.status = ProjectionStatus::NotAnEllipse;
     return out;
   }
   out.status = ProjectionStatus::Ok;
-  out.ellipse = *e;
+  out.ellipse = *ellipse;
   return out;
+}
+
+/// Projects an ellipsoid with a world->camera pose. The image is an ellipse exactly when the
+/// ellipsoid lies strictly in front of the camera's principal plane (z_c > 0 everywhere);
+/// every other case returns a status, never a NaN.
+inline Projection project(const Ellipsoid& ellipsoid, const Intrinsics& K, const Pose& pose) {
+  if (!ellipsoid.isValid() || !K.isValid() || !pose.isValid()) return Projection{};
+  return projectPrepared(ProjectableEllipsoid(ellipsoid), projectionMatrix(K, pose), pose);
 }
 
 }  // namespace ellreloc

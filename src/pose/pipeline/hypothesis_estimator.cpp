@@ -25,7 +25,7 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
   own->count = 0;
   for (int k = 0; k < count; ++k) {
     const CandidatePair& c = pairs_[static_cast<size_t>(pair_indices[k])];
-    const Projection p = project(map_.objects[static_cast<size_t>(c.object)].ellipsoid, K_, pose);
+    const Projection p = scorer_.projectObject(c.object, pose);
     if (!p.ok()) return false;
     own->objects[k] = c.object;
     own->ellipses[k] = p.ellipse;
@@ -66,7 +66,7 @@ bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
   std::array<Eigen::Vector3d, 3> bearings, centres;
   for (int k = 0; k < 3; ++k) {
     const Ellipsoid& e = map_.objects[pairs_[s[k]].object].ellipsoid;
-    const Projection p = project(e, K_, *pose);
+    const Projection p = scorer_.projectObject(pairs_[s[k]].object, *pose);
     if (!p) return false;
     const Eigen::Vector2d offset = p.ellipse.center() - K_.project(pose->transform(e.center()));
     bearings[k] = K_.bearing(observations_[pairs_[s[k]].observation].ellipse.center() - offset);

@@ -14,8 +14,12 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
   std::vector<char> relevant(map.objects.size(), 0);
   for (const auto& c : cands)
     for (int j : c) relevant[static_cast<size_t>(j)] = 1;
+  prepared_.resize(map.objects.size());
   for (size_t j = 0; j < relevant.size(); ++j)
-    if (relevant[j]) relevant_.push_back(static_cast<int>(j));
+    if (relevant[j]) {
+      relevant_.push_back(static_cast<int>(j));
+      prepared_[j] = ProjectableEllipsoid(map.objects[j].ellipsoid);
+    }
   // A match to an object that carried the observed label in only a minority of its detections
   // is worth that share of a match (full at a majority, share >= 0.5).
   label_weight_.resize(cands.size());
@@ -39,6 +43,8 @@ double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int v
 
 double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches,
                         const KnownProjections* known) {
+  const bool valid = K_.isValid() && pose.isValid();  // checked once, not per object
+  const Eigen::Matrix<double, 3, 4> P = valid ? projectionMatrix(K_, pose) : Eigen::Matrix<double, 3, 4>::Zero();
   for (int j : relevant_) {
     const int* k = known ? std::find(known->objects, known->objects + known->count, j) : nullptr;
     if (known && k != known->objects + known->count) {
@@ -46,7 +52,7 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
       projected_[j] = known->ellipses[k - known->objects];
       continue;
     }
-    const Projection p = project(map_.objects[static_cast<size_t>(j)].ellipsoid, K_, pose);
+    const Projection p = valid ? projectPrepared(prepared_[static_cast<size_t>(j)], P, pose) : Projection{};
     projects_[j] = p.ok();
     if (p.ok()) projected_[j] = p.ellipse;
   }
@@ -60,8 +66,15 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
       if (!projects_[j]) continue;
       const Box pb = projected_[j].boundingBox();
       if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
-      const double ov = options_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, pb)
-                                                                   : ellipseIoU(o.ellipse, projected_[j], vertices);
+      double ov = 0.0;
+      if (options_.overlap == OverlapMeasure::BoxIoU) {
+        ov = boxIoU(o.box, pb);
+      } else {
+        // The exact overlap costs an atan2 per polygon vertex: pairs that cannot reach
+        // min_overlap (by their areas and boxes) are skipped first; the margin absorbs rounding.
+        if (ellipseIoUUpperBound(o.ellipse, projected_[j], vertices) < options_.min_overlap - 1e-9) continue;
+        ov = ellipseIoU(o.ellipse, projected_[j], vertices);
+      }
       if (ov >= options_.min_overlap) all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
     }
   }

@@ -6,6 +6,7 @@
 
 #include "candidates.hpp"
 #include "ellreloc/core/camera.hpp"
+#include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 
 namespace ellreloc::pipeline {
@@ -37,6 +38,13 @@ class PoseScorer {
   double cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches = nullptr,
               const KnownProjections* known = nullptr);
 
+  /// project(map object j, K, pose), with the object's quantities computed once; j must be a
+  /// candidate of some observation.
+  Projection projectObject(int j, const Pose& pose) const {
+    if (!K_.isValid() || !pose.isValid()) return Projection{};
+    return projectPrepared(prepared_[static_cast<size_t>(j)], projectionMatrix(K_, pose), pose);
+  }
+
   const ScoringOptions& options() const { return options_; }
 
  private:
@@ -46,6 +54,7 @@ class PoseScorer {
   const Intrinsics& K_;
   const ScoringOptions& options_;
   std::vector<int> relevant_;                      // objects that are some observation's candidate
+  std::vector<ProjectableEllipsoid> prepared_;     // per map object (filled for the relevant ones)
   std::vector<std::vector<double>> label_weight_;  // per observation, per candidate
   // Scratch, reused across calls.
   std::vector<Ellipse> projected_;
