@@ -57,7 +57,7 @@ class Ellipse {
   Ellipse() = default;
   /// No validation here: check isValid(), or use a named constructor that returns optional.
   Ellipse(const Eigen::Vector2d& center, const Eigen::Vector2d& axes, double angle)
-      : center_(center), axes_(axes), angle_(angle) {}
+      : center_(center), axes_(axes), angle_(angle), cos_(std::cos(angle)), sin_(std::sin(angle)) {}
 
   /// Recovers the ellipse from a dual conic of any scale and sign (normalised internally).
   /// Returns nullopt when the matrix is not finite or does not describe a real ellipse.
@@ -105,14 +105,21 @@ class Ellipse {
   }
 
   Eigen::Matrix2d rotation() const {
-    const double c = std::cos(angle_), s = std::sin(angle_);
     Eigen::Matrix2d R;
-    R << c, -s, s, c;
+    R << cos_, -sin_, sin_, cos_;
     return R;
   }
 
-  /// Covariance of the Gaussian form: R diag(a^2, b^2) R^T.
-  Eigen::Matrix2d covariance() const { return ellipseCovariance(axes_(0), axes_(1), angle_); }
+  /// Covariance of the Gaussian form: R diag(a^2, b^2) R^T (ellipseCovariance, with the
+  /// rotation's cosine and sine computed once).
+  Eigen::Matrix2d covariance() const {
+    const double a2 = axes_(0) * axes_(0), b2 = axes_(1) * axes_(1);
+    Eigen::Matrix2d S;
+    S(0, 0) = cos_ * cos_ * a2 + sin_ * sin_ * b2;
+    S(1, 1) = sin_ * sin_ * a2 + cos_ * cos_ * b2;
+    S(0, 1) = S(1, 0) = cos_ * sin_ * (a2 - b2);
+    return S;
+  }
 
   /// Dual conic, normalised so that C*(2,2) = -1.
   Eigen::Matrix3d dualConic() const {
@@ -171,6 +178,7 @@ class Ellipse {
   Eigen::Vector2d center_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d axes_ = Eigen::Vector2d::Ones();
   double angle_ = 0.0;
+  double cos_ = 1.0, sin_ = 0.0;  // of angle_: every rotation and covariance needs them
 };
 
 }  // namespace ellreloc

@@ -1,6 +1,7 @@
 #include "pose_scorer.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
@@ -14,6 +15,13 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
   std::vector<char> relevant(map.objects.size(), 0);
   for (const auto& c : cands)
     for (int j : c) relevant[static_cast<size_t>(j)] = 1;
+  candidate_area_.assign(map.objects.size(), Box(INFINITY, INFINITY, -INFINITY, -INFINITY));
+  for (size_t i = 0; i < cands.size(); ++i)
+    for (int j : cands[i]) {
+      Box& a = candidate_area_[static_cast<size_t>(j)];
+      const Box& b = observations[i].box;
+      a = Box(std::min(a.x1, b.x1), std::min(a.y1, b.y1), std::max(a.x2, b.x2), std::max(a.y2, b.y2));
+    }
   prepared_.resize(map.objects.size());
   for (size_t j = 0; j < relevant.size(); ++j)
     if (relevant[j]) {
@@ -36,6 +44,25 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
   all_matches_.reserve(64);
 }
 
+namespace {
+
+/// Whether the image of an ellipsoid (centre c, largest semi-axis r) under a valid pose
+/// certainly misses `area`: the image lies within that of the cube of side 2r around c, whose
+/// extremes are at its corners when the cube is in front of the camera. A pixel of margin keeps
+/// the test conservative under rounding.
+bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, const Intrinsics& K, const Box& area) {
+  const Eigen::Vector3d x = pose.rotation() * c + pose.translation();
+  const double z_near = x(2) - r, z_far = x(2) + r;
+  if (!(z_near > 0.0)) return false;
+  const double u1 = std::min((x(0) - r) / z_near, (x(0) - r) / z_far) * K.fx + K.cx - 1.0;
+  const double u2 = std::max((x(0) + r) / z_near, (x(0) + r) / z_far) * K.fx + K.cx + 1.0;
+  const double v1 = std::min((x(1) - r) / z_near, (x(1) - r) / z_far) * K.fy + K.cy - 1.0;
+  const double v2 = std::max((x(1) + r) / z_near, (x(1) + r) / z_far) * K.fy + K.cy + 1.0;
+  return u2 <= area.x1 || area.x2 <= u1 || v2 <= area.y1 || area.y2 <= v1;
+}
+
+}  // namespace
+
 double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int vertices) const {
   return options_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, projected.boundingBox())
                                                     : ellipseIoU(o.ellipse, projected, vertices);
@@ -52,7 +79,15 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
       projected_[j] = known->ellipses[k - known->objects];
       continue;
     }
-    const Projection p = valid ? projectPrepared(prepared_[static_cast<size_t>(j)], P, pose) : Projection{};
+    // Most objects are out of view at most poses: a cheap test spares their projection.
+    const ProjectableEllipsoid& e = prepared_[static_cast<size_t>(j)];
+    if (valid && e.valid &&
+        certainlyOutside(e.ellipsoid.center(), e.ellipsoid.axes().maxCoeff(), pose, K_,
+                         candidate_area_[static_cast<size_t>(j)])) {
+      projects_[j] = 0;
+      continue;
+    }
+    const Projection p = valid ? projectPrepared(e, P, pose) : Projection{};
     projects_[j] = p.ok();
     if (p.ok()) projected_[j] = p.ellipse;
   }
