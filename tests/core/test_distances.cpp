@@ -181,6 +181,19 @@ TEST(EllipseIoU, UpperBoundHoldsAndPrunes) {
   EXPECT_NEAR(ellipseIoUUpperBound(Ellipse({0, 0}, {2, 1}, 0), Ellipse({0, 0}, {2, 1}, 0)), 1.0, 1e-12);
 }
 
+TEST(EllipseIoU, FastAtan2IsWithin2e8OfStdAtan2) {
+  std::mt19937 rng(136);
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const double y = i % 7 == 0 ? 0.0 : uniform(rng, -10, 10), x = i % 11 == 0 ? 0.0 : uniform(rng, -10, 10);
+    worst = std::max(worst, std::abs(detail::fastAtan2(y, x) - std::atan2(y, x)));
+  }
+  EXPECT_LT(worst, 2e-8);
+  EXPECT_EQ(detail::fastAtan2(0.0, 0.0), 0.0);
+  EXPECT_NEAR(detail::fastAtan2(1.0, -1.0), 0.75 * M_PI, 2e-8);
+  EXPECT_NEAR(detail::fastAtan2(-1e-300, 1.0), 0.0, 1e-12);
+}
+
 TEST(BoxIoU, HandComputedAndDegenerate) {
   EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(5, 0, 15, 10)), 50.0 / 150.0);
   EXPECT_DOUBLE_EQ(boxIoU(Box(0, 0, 10, 10), Box(0, 0, 10, 10)), 1.0);

