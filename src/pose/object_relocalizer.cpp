@@ -147,6 +147,17 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
                   std::to_string(usable) + " usable observation(s) with a candidate object; " + std::to_string(needed) +
                       " needed" + (few && !gravity && usable == 1 ? " (or 1 with a gravity prior)" : ""));
 
+  // A pose explains each usable observation at most fully: with fewer than the evidence the
+  // acceptance test asks for, no pose could be reported, so none is searched for.
+  if (options_.acceptance.enabled && usable < options_.acceptance.min_evidence) {
+    char reason[200];
+    std::snprintf(reason, sizeof reason,
+                  "%d usable observation(s) cannot reach the evidence %.2f a pose needs (acceptance off gives the "
+                  "pose for a host's own check)",
+                  usable, options_.acceptance.min_evidence);
+    return finish(RelocalizationStatus::NotEnoughObservations, reason);
+  }
+
   // 2. Hypotheses into the pool: triplets, then pairs when the frame has few observations or
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);

@@ -219,11 +219,13 @@ TEST(ObjectRelocalizer, BudgetsHoldOnEveryPathIncludingZero) {
   const std::vector<Observation> two(s.observations.begin(), s.observations.begin() + 2);
   const std::vector<Observation> one(s.observations.begin(), s.observations.begin() + 1);
   const GravityPrior gravity{s.truth.rotation() * Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ(), 1.0};
-  const ObjectRelocalizer unbounded(s.map, K);
+  RelocalizerOptions every_pose;  // with the acceptance test, one or two objects are never searched
+  every_pose.acceptance.enabled = false;
+  const ObjectRelocalizer unbounded(s.map, K, every_pose);
   ASSERT_GT(unbounded.relocalize(two).few_object_hypotheses, 0);
   ASSERT_GT(unbounded.relocalize(one, {}, gravity).few_object_hypotheses, 0);
   for (long max_hypotheses : {0L, 3L}) {
-    RelocalizerOptions o;
+    RelocalizerOptions o = every_pose;
     o.search.budget.max_hypotheses = max_hypotheses;
     const ObjectRelocalizer bounded(s.map, K, o);
     for (const auto& [observations, prior] :
@@ -235,7 +237,7 @@ TEST(ObjectRelocalizer, BudgetsHoldOnEveryPathIncludingZero) {
     }
   }
   // A budget spent before the search starts: no hypothesis at all, on every path.
-  RelocalizerOptions no_time;
+  RelocalizerOptions no_time = every_pose;
   no_time.search.budget.max_time_ms = 1e-9;
   const ObjectRelocalizer hurried(s.map, K, no_time);
   EXPECT_EQ(hurried.relocalize(s.observations).hypotheses, 0);
@@ -374,11 +376,14 @@ TEST(ObjectRelocalizer, TwoObservationsGiveThePose) {
     if (s.observations.size() < 2) continue;
     s.observations.resize(2);
     ++tried;
-    // Two objects never reach the default evidence: the pose comes as LowEvidence, for a host's
-    // own check.
-    const RelocalizationResult r = ObjectRelocalizer(s.map, K).relocalize(s.observations);
-    EXPECT_NE(r.status, RelocalizationStatus::Success);
-    if (r.status == RelocalizationStatus::LowEvidence && positionError(r.pose, s.truth) < 0.02 &&
+    // Two objects never reach the default evidence: no search at all unless the acceptance test
+    // is off (a host that checks poses itself); then the pose comes as Success.
+    EXPECT_EQ(ObjectRelocalizer(s.map, K).relocalize(s.observations).status,
+              RelocalizationStatus::NotEnoughObservations);
+    RelocalizerOptions every_pose;
+    every_pose.acceptance.enabled = false;
+    const RelocalizationResult r = ObjectRelocalizer(s.map, K, every_pose).relocalize(s.observations);
+    if (r.status == RelocalizationStatus::Success && positionError(r.pose, s.truth) < 0.02 &&
         rotationErrorDeg(r.pose.rotation(), s.truth.rotation()) < 0.5) {
       ++recovered;
       EXPECT_GT(r.few_object_hypotheses, 0);
@@ -403,11 +408,15 @@ TEST(ObjectRelocalizer, OneObservationWithGravity) {
     if (s.observations.empty()) continue;
     s.observations.resize(1);
     ++tried;
-    const ObjectRelocalizer reloc(s.map, K);
+    RelocalizerOptions every_pose;  // one object never reaches the default evidence
+    every_pose.acceptance.enabled = false;
+    const ObjectRelocalizer reloc(s.map, K, every_pose);
     EXPECT_EQ(reloc.relocalize(s.observations).status, RelocalizationStatus::NotEnoughObservations);
     const GravityPrior g = GravityPrior::atPose(s.truth);
+    EXPECT_EQ(ObjectRelocalizer(s.map, K).relocalize(s.observations, {}, g).status,
+              RelocalizationStatus::NotEnoughObservations);
     const RelocalizationResult r = reloc.relocalize(s.observations, {}, g);
-    if (r.status != RelocalizationStatus::LowEvidence) continue;  // one object: never enough evidence alone
+    if (r.status != RelocalizationStatus::Success) continue;
     const Ellipsoid& e = s.map.objects[s.object_of[0]].ellipsoid;
     const Eigen::Matrix3d mirror = Eigen::AngleAxisd(M_PI, e.rotation().col(2)).toRotationMatrix();
     const Pose mirrored(s.truth.rotation() * mirror.transpose(),

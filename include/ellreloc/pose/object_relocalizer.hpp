@@ -34,7 +34,8 @@ namespace ellreloc {
 
 enum class RelocalizationStatus {
   Success,
-  NotEnoughObservations,   ///< too few usable observations with a candidate object (see RelocalizerOptions)
+  NotEnoughObservations,   ///< too few usable observations with a candidate object for the solvers, or to
+                           ///< reach acceptance.min_evidence (see RelocalizerOptions)
   NoConsistentHypothesis,  ///< no pose explains at least scoring.min_inliers observations
   InvalidInput,            ///< invalid intrinsics, gravity prior or options
   /// A pose was found but the observations support it too weakly (RelocalizationResult::evidence

@@ -116,7 +116,8 @@ struct RefinementStageOptions {
 /// it leaves unexplained. Poses below `min_evidence` get LowEvidence, not Success: calibrated on
 /// frames of random boxes of the maps' categories and on frames of one scene against another
 /// scene's map (docs/reliability.md), of which 1% pass; at 2.3 a pose needs at least three
-/// matches, so frames with one or two objects need a host's own check (acceptance off).
+/// matches, so frames with fewer usable observations are not searched (NotEnoughObservations):
+/// a host that checks poses itself turns the test off to get theirs.
 struct AcceptanceOptions {
   bool enabled = true;
   double min_evidence = 2.3;
