@@ -68,6 +68,14 @@ double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int v
                                                     : ellipseIoU(o.ellipse, projected, vertices);
 }
 
+bool PoseScorer::overlapReaches(const Observation& o, const Ellipse& projected, int vertices, double threshold) const {
+  // The bound spares the exact IoU of pairs that cannot reach the threshold; the margin absorbs rounding.
+  if (options_.overlap == OverlapMeasure::EllipseIoU &&
+      ellipseIoUUpperBound(o.ellipse, projected, vertices) < threshold - 1e-9)
+    return false;
+  return overlap(o, projected, vertices) >= threshold;
+}
+
 double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches,
                         const KnownProjections* known) {
   const bool valid = K_.isValid() && pose.isValid();  // checked once, not per object
