@@ -7,13 +7,13 @@ namespace ellreloc::pipeline {
 
 namespace {
 
-/// The label share through which map object m may be observation o, or a negative number when
-/// it may not (another category, below the options' share, or an unusable object).
+/// The label share through which a usable map object m may be observation o, or a negative
+/// number when it may not (another category, or below the options' share).
 double candidateShare(const Observation& o, const MapObject& m, const ScoringOptions& options) {
   const double share =
       m.category == o.category ? std::max(m.categoryShare(o.category), 0.5) : m.categoryShare(o.category);
-  if (!mapObjectUsable(m) || !(share >= std::min(options.min_category_share, 0.5) &&
-                               (m.category == o.category || share >= options.min_category_share)))
+  if (!(share >= std::min(options.min_category_share, 0.5) &&
+        (m.category == o.category || share >= options.min_category_share)))
     return -1.0;
   return share;
 }
@@ -31,13 +31,16 @@ Candidates collectCandidates(const std::vector<Observation>& observations, const
   // keep their candidates.
   std::vector<long> count(observations.size(), 0);
   std::vector<size_t> order;
+  std::vector<char> object_usable(map.objects.size());  // checked once per object, not per pair
+  for (size_t j = 0; j < map.objects.size(); ++j) object_usable[j] = mapObjectUsable(map.objects[j]);
   for (size_t i = 0; i < observations.size(); ++i) {
     const Observation& o = observations[i];
     if (!o.ellipse.isValid() || !o.box.isValid() || !std::isfinite(o.score)) {
       skipped->emplace_back(static_cast<int>(i), "invalid ellipse, box or score (NaN, infinite or empty)");
       continue;
     }
-    for (const MapObject& m : map.objects) count[i] += candidateShare(o, m, options) >= 0.0;
+    for (size_t j = 0; j < map.objects.size(); ++j)
+      count[i] += object_usable[j] && candidateShare(o, map.objects[j], options) >= 0.0;
     if (count[i] == 0) {
       skipped->emplace_back(static_cast<int>(i), "no map object of category " + std::to_string(o.category));
       continue;
@@ -63,7 +66,7 @@ Candidates collectCandidates(const std::vector<Observation>& observations, const
     const Observation& o = observations[i];
     for (size_t j = 0; j < map.objects.size(); ++j) {
       const MapObject& m = map.objects[j];
-      const double share = candidateShare(o, m, options);
+      const double share = object_usable[j] ? candidateShare(o, m, options) : -1.0;
       if (share < 0.0) continue;
       c.of_observation[i].push_back(static_cast<int>(j));
       // Likelier labels, surer detections and larger objects first: PROSAC order.
