@@ -32,8 +32,8 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
     own->count = k + 1;
   }
   for (int k = 0; k < count && check_overlap; ++k)
-    if (!scorer_.overlapReaches(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k],
-                                kRankingIoUVertices, options_.scoring.min_overlap))
+    if (scorer_.overlapReaching(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k],
+                                kRankingIoUVertices, options_.scoring.min_overlap) < options_.scoring.min_overlap)
       return false;
   return true;
 }

@@ -68,12 +68,13 @@ double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int v
                                                     : ellipseIoU(o.ellipse, projected, vertices);
 }
 
-bool PoseScorer::overlapReaches(const Observation& o, const Ellipse& projected, int vertices, double threshold) const {
-  // The bound spares the exact IoU of pairs that cannot reach the threshold; the margin absorbs rounding.
+double PoseScorer::overlapReaching(const Observation& o, const Ellipse& projected, int vertices,
+                                   double threshold) const {
+  // The margin absorbs the rounding between the bound and the exact overlap.
   if (options_.overlap == OverlapMeasure::EllipseIoU &&
       ellipseIoUUpperBound(o.ellipse, projected, vertices) < threshold - 1e-9)
-    return false;
-  return overlap(o, projected, vertices) >= threshold;
+    return 0.0;
+  return overlap(o, projected, vertices);
 }
 
 double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches,
@@ -109,15 +110,7 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
       if (!projects_[j]) continue;
       const Box pb = projected_[j].boundingBox();
       if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
-      double ov = 0.0;
-      if (options_.overlap == OverlapMeasure::BoxIoU) {
-        ov = boxIoU(o.box, pb);
-      } else {
-        // The exact overlap costs an atan2 per polygon vertex: pairs that cannot reach
-        // min_overlap (by their areas and boxes) are skipped first; the margin absorbs rounding.
-        if (ellipseIoUUpperBound(o.ellipse, projected_[j], vertices) < options_.min_overlap - 1e-9) continue;
-        ov = ellipseIoU(o.ellipse, projected_[j], vertices);
-      }
+      const double ov = overlapReaching(o, projected_[j], vertices, options_.min_overlap);
       if (ov >= options_.min_overlap) all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
     }
   }

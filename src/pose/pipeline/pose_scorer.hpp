@@ -32,9 +32,10 @@ class PoseScorer {
 
   /// The overlap of an observation and a projected ellipse under the options' measure.
   double overlap(const Observation& o, const Ellipse& projected, int vertices) const;
-  /// overlap(o, projected, vertices) >= threshold, answered without the exact overlap when its
-  /// upper bound is already below.
-  bool overlapReaches(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
+  /// overlap(o, projected, vertices), or 0 when its upper bound already shows that it is below
+  /// `threshold` (the exact ellipse IoU costs an atan2 per polygon vertex; the bound a few
+  /// operations).
+  double overlapReaching(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
 
   /// The cost of a pose: unmatched_cost per usable observation, less (unmatched_cost - (1 -
   /// credit)) per one-to-one match, greedy on credit. Fills the matches when asked.
