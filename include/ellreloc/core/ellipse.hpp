@@ -37,18 +37,23 @@ void gaussianFromDualConic(const Mat3<T>& C, Vec2<T>* mean, Mat2<T>* cov) {
   *cov = S;
 }
 
-/// Covariance R(angle) diag(a^2, b^2) R(angle)^T, templated for Ceres.
+/// Covariance R diag(a^2, b^2) R^T for the rotation of cosine c and sine s, templated for Ceres.
 template <typename T>
-Mat2<T> ellipseCovariance(const T& a, const T& b, const T& angle) {
-  using std::cos;
-  using std::sin;
-  const T c = cos(angle), s = sin(angle);
+Mat2<T> ellipseCovariance(const T& a, const T& b, const T& c, const T& s) {
   const T a2 = a * a, b2 = b * b;
   Mat2<T> S;
   S(0, 0) = c * c * a2 + s * s * b2;
   S(1, 1) = s * s * a2 + c * c * b2;
   S(0, 1) = S(1, 0) = c * s * (a2 - b2);
   return S;
+}
+
+/// Covariance R(angle) diag(a^2, b^2) R(angle)^T, templated for Ceres.
+template <typename T>
+Mat2<T> ellipseCovariance(const T& a, const T& b, const T& angle) {
+  using std::cos;
+  using std::sin;
+  return ellipseCovariance<T>(a, b, cos(angle), sin(angle));
 }
 
 class Ellipse {
@@ -110,16 +115,8 @@ class Ellipse {
     return R;
   }
 
-  /// Covariance of the Gaussian form: R diag(a^2, b^2) R^T (ellipseCovariance, with the
-  /// rotation's cosine and sine computed once).
-  Eigen::Matrix2d covariance() const {
-    const double a2 = axes_(0) * axes_(0), b2 = axes_(1) * axes_(1);
-    Eigen::Matrix2d S;
-    S(0, 0) = cos_ * cos_ * a2 + sin_ * sin_ * b2;
-    S(1, 1) = sin_ * sin_ * a2 + cos_ * cos_ * b2;
-    S(0, 1) = S(1, 0) = cos_ * sin_ * (a2 - b2);
-    return S;
-  }
+  /// Covariance of the Gaussian form: R diag(a^2, b^2) R^T.
+  Eigen::Matrix2d covariance() const { return ellipseCovariance(axes_(0), axes_(1), cos_, sin_); }
 
   /// Dual conic, normalised so that C*(2,2) = -1.
   Eigen::Matrix3d dualConic() const {
