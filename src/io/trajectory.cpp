@@ -8,23 +8,11 @@
 #include <set>
 #include <sstream>
 
+#include "ellreloc/core/detection.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 
 namespace ellreloc::io {
-
-namespace {
-
-/// A timestamp field: a finite decimal number and nothing else; nullopt otherwise.
-std::optional<double> parseTimestamp(const std::string& text) {
-  double t = 0.0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, t);
-  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(t)) return std::nullopt;
-  return t;
-}
-
-}  // namespace
 
 std::vector<StampedPose> readTumTrajectory(const std::string& path, bool allow_empty) {
   std::vector<StampedPose> poses;
@@ -34,7 +22,7 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path, bool allow_e
     std::istringstream fields(line);
     std::string stamp;
     fields >> stamp;
-    const std::optional<double> t = parseTimestamp(stamp);
+    const std::optional<double> t = timestampFromText(stamp);
     if (!t) throw Error(where + "timestamp '" + stamp + "' is not a finite number");
     double v[8] = {*t};
     for (int k = 1; k < 8; ++k) {
@@ -66,7 +54,7 @@ void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>&
       const auto [end, ec] = std::to_chars(text, text + sizeof text, p.timestamp);  // shortest round trip
       stamp.assign(text, end);
     }
-    const std::optional<double> t_read = parseTimestamp(stamp);
+    const std::optional<double> t_read = timestampFromText(stamp);
     if (!t_read) throw Error(path + ": refusing to write the timestamp '" + stamp + "': not a finite number");
     if (!written.insert(*t_read).second) throw Error(path + ": refusing to write two poses at timestamp " + stamp);
     const Pose inv = p.pose.inverse();  // camera->world

@@ -6,7 +6,6 @@
 #include <Eigen/Core>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +33,15 @@ struct Keypoint {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();
 };
 
+/// A timestamp written as text (a TUM file's first field, an image's base name): a plain
+/// decimal number, finite, and nothing else; nullopt otherwise.
+inline std::optional<double> timestampFromText(const std::string& text) {
+  double t = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), t);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(t)) return std::nullopt;
+  return t;
+}
+
 struct DetectionFrame {
   std::string file_name;
   std::vector<Detection> detections;
@@ -48,15 +56,8 @@ struct DetectionFrame {
     if (dot != std::string::npos && dot > 0) base = base.substr(0, dot);
     return base;
   }
-  /// timestampText() as a number (a plain decimal, as TUM files write them); nullopt when it
-  /// is not one.
-  std::optional<double> timestamp() const {
-    const std::string text = timestampText();
-    double t = 0.0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), t);
-    if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(t)) return std::nullopt;
-    return t;
-  }
+  /// timestampText() as a number (timestampFromText); nullopt when it is not one.
+  std::optional<double> timestamp() const { return timestampFromText(timestampText()); }
 };
 
 }  // namespace ellreloc
