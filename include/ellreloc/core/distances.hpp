@@ -122,8 +122,8 @@ inline PolygonConstants polygonConstants(int vertices) {
   return vertices == 32 ? c32 : vertices == 128 ? c128 : makePolygonConstants(vertices);
 }
 
-/// atan2(y, x) to 2e-8 radians (Abramowitz & Stegun 4.4.49 on [0, 1], octant reduction): three
-/// times cheaper than std::atan2, far below the IoU polygon's own error.
+/// atan2(y, x) to 2e-8 radians (Abramowitz & Stegun 4.4.49 on [0, 1], octant reduction): about
+/// 1.5 times cheaper than std::atan2, with an error far below the IoU polygon's own.
 inline double fastAtan2(double y, double x) {
   const double ax = std::abs(x), ay = std::abs(y);
   const double hi = std::max(ax, ay), lo = std::min(ax, ay);
