@@ -20,10 +20,8 @@ CLI::App* addObserveCommand(CLI::App& app, ObserveArgs& a) {
 }
 
 ObservationPolicy parsePolicy(const std::string& name) {
-  if (name == "paper") return ObservationPolicy::Paper;
-  if (name == "bbox") return ObservationPolicy::Bbox;
-  if (name == "mask") return ObservationPolicy::Mask;
-  if (name == "given") return ObservationPolicy::Given;
+  ObservationPolicy policy;
+  if (parseObservationPolicy(name, &policy)) return policy;
   throw Error("--policy: unknown policy '" + name + "' (paper, bbox, mask, given)");
 }
 

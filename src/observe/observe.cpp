@@ -40,6 +40,27 @@ std::string ObserveOptions::validate() const {
   return "";
 }
 
+const char* toString(ObservationPolicy policy) {
+  switch (policy) {
+    case ObservationPolicy::Paper:
+      return "paper";
+    case ObservationPolicy::Bbox:
+      return "bbox";
+    case ObservationPolicy::Mask:
+      return "mask";
+    case ObservationPolicy::Given:
+      return "given";
+  }
+  return "unknown";
+}
+
+bool parseObservationPolicy(const std::string& name, ObservationPolicy* policy) {
+  for (ObservationPolicy p :
+       {ObservationPolicy::Paper, ObservationPolicy::Bbox, ObservationPolicy::Mask, ObservationPolicy::Given})
+    if (name == toString(p)) return *policy = p, true;
+  return false;
+}
+
 ObserveResult observeDetection(const Detection& d, int width, int height, const ObserveOptions& opt) {
   ObserveResult r;
   if (std::string problem = opt.validate(); !problem.empty()) {

@@ -48,7 +48,7 @@ void writeRgb(const std::string& path, const RenderedFrame& f) {
 void makeDirs(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) throw Error(dir + ": cannot create directory: " + ec.message());
+  if (ec) throw FileError(dir + ": cannot create directory: " + ec.message());
 }
 
 }  // namespace

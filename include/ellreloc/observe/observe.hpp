@@ -20,6 +20,10 @@ enum class ObservationPolicy {
   Given,  ///< the detection's own `ellipse` field
 };
 
+/// Name <-> policy: "paper", "bbox", "mask", "given".
+const char* toString(ObservationPolicy policy);
+bool parseObservationPolicy(const std::string& name, ObservationPolicy* policy);
+
 /// How an ellipse is fitted to a mask.
 enum class MaskFitMethod {
   Moments,        ///< same second moments as the mask (from the RLE runs, no decoding)

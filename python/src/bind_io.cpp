@@ -1,0 +1,136 @@
+/// \file bind_io.cpp
+/// Files of docs/formats.md: cameras, maps, detections, TUM trajectories and depth PNGs. Paths
+/// may be str or os.PathLike. Unreadable files raise OSError, malformed ones ValueError.
+
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+#include "ellreloc/io/camera.hpp"
+#include "ellreloc/io/detections.hpp"
+#include "ellreloc/io/map.hpp"
+#include "ellreloc/io/rgbd.hpp"
+#include "ellreloc/io/trajectory.hpp"
+
+namespace ellreloc::python {
+namespace {
+
+std::string pathFrom(const py::handle& h) {
+  if (!py::isinstance<py::str>(h) && !py::hasattr(h, "__fspath__"))
+    badArgument("path", "expected a str or os.PathLike, got " + describe(h));
+  return py::str(py::module_::import("os").attr("fspath")(h));
+}
+
+io::StampedPose stampedFrom(const py::handle& h) {
+  if (py::isinstance<io::StampedPose>(h)) return h.cast<io::StampedPose>();
+  if (py::isinstance<py::tuple>(h) && py::len(h) == 2) {
+    const auto t = h.cast<py::tuple>();
+    io::StampedPose p;
+    p.pose = t[1].cast<Pose>();
+    if (py::isinstance<py::str>(t[0])) {
+      p.stamp = t[0].cast<std::string>();
+      const std::optional<double> v = timestampFromText(p.stamp);
+      if (!v) badArgument("poses", "timestamp '" + p.stamp + "' is not a finite number");
+      p.timestamp = *v;
+    } else {
+      p.timestamp = t[0].cast<double>();
+    }
+    return p;
+  }
+  badArgument("poses", "expected StampedPose or (timestamp, Pose) items, found " + describe(h));
+}
+
+void bindTrajectory(py::module_& m) {
+  py::class_<io::StampedPose>(m, "StampedPose", "A timestamped world->camera pose of a TUM trajectory.")
+      .def(py::init([](double t, const Pose& p, std::string stamp) {
+             return io::StampedPose{t, p, std::move(stamp)};
+           }),
+           py::arg("timestamp"), py::arg("pose"), py::arg("stamp") = "")
+      .def_readwrite("timestamp", &io::StampedPose::timestamp)
+      .def_readwrite("pose", &io::StampedPose::pose)
+      .def_readwrite("stamp", &io::StampedPose::stamp,
+                     "the timestamp's text as read ('' = write the shortest exact decimal)")
+      .def("__repr__", [](const io::StampedPose& p) {
+        return "StampedPose(" + (p.stamp.empty() ? std::to_string(p.timestamp) : p.stamp) + ", " +
+               std::string(py::repr(py::cast(p.pose))) + ")";
+      });
+  m.def(
+      "read_trajectory",
+      [](const py::handle& path, bool allow_empty) { return io::readTumTrajectory(pathFrom(path), allow_empty); },
+      py::arg("path"), py::arg("allow_empty") = false,
+      "A TUM trajectory (camera->world on disk) as StampedPose items holding world->camera poses.");
+  m.def(
+      "write_trajectory",
+      [](const py::handle& path, const py::handle& poses) {
+        std::vector<io::StampedPose> list;
+        for (const py::handle& item : poses) list.push_back(stampedFrom(item));
+        io::writeTumTrajectory(pathFrom(path), list);
+      },
+      py::arg("path"), py::arg("poses"),
+      "Writes StampedPose or (timestamp, Pose) items as a TUM trajectory, atomically; a str timestamp is "
+      "written as given.");
+  m.def("find_nearest", &io::findNearest, py::arg("poses"), py::arg("timestamp"), py::arg("tolerance") = 0.02,
+        "Index of the pose nearest in time, if within `tolerance` seconds, else None.");
+}
+
+void bindFiles(py::module_& m) {
+  m.def(
+      "read_camera", [](const py::handle& path) { return io::readCamera(pathFrom(path)); }, py::arg("path"),
+      "Intrinsics from ORB-SLAM YAML or JSON.");
+  m.def(
+      "write_camera", [](const py::handle& path, const Intrinsics& K) { io::writeCamera(pathFrom(path), K); },
+      py::arg("path"), py::arg("camera"), "JSON for a .json path, ORB-SLAM YAML otherwise.");
+  m.def(
+      "read_map",
+      [](const py::handle& path) {
+        std::vector<std::string> warnings;
+        ObjectMap map = io::readMap(pathFrom(path), &warnings);
+        const py::object warn = py::module_::import("warnings").attr("warn");
+        for (const std::string& w : warnings) warn(w, py::module_::import("builtins").attr("UserWarning"), 2);
+        return map;
+      },
+      py::arg("path"),
+      "A JSON or OA-SLAM text map. Objects that cannot be used are left out with a UserWarning naming them.");
+  m.def(
+      "write_map", [](const py::handle& path, const ObjectMap& map) { io::writeMap(pathFrom(path), map); },
+      py::arg("path"), py::arg("map"), "Writes the JSON map atomically.");
+  m.def(
+      "read_detections",
+      [](const py::handle& path) {
+        const std::string p = pathFrom(path);
+        py::gil_scoped_release release;
+        return io::readDetections(p);
+      },
+      py::arg("path"), "A detections file as a list of DetectionFrame.");
+  m.def(
+      "write_detections",
+      [](const py::handle& path, const std::vector<DetectionFrame>& frames) {
+        io::writeDetections(pathFrom(path), frames);
+      },
+      py::arg("path"), py::arg("frames"), "Writes a detections file atomically (masks as compressed COCO strings).");
+  m.def(
+      "read_depth_png",
+      [](const py::handle& path, double units_per_metre) {
+        DepthImage d = io::readDepthPng(pathFrom(path), units_per_metre);
+        return adoptVector(std::move(d.metres), {d.height, d.width});
+      },
+      py::arg("path"), py::arg("units_per_metre") = io::kTumDepthUnitsPerMetre,
+      "A 16-bit depth PNG as a (height, width) float32 array in metres (0 = no reading).");
+  py::class_<io::Association>(m, "Association", "A line of a TUM association file.")
+      .def_readonly("rgb_time", &io::Association::rgb_time)
+      .def_readonly("rgb_path", &io::Association::rgb_path)
+      .def_readonly("depth_time", &io::Association::depth_time)
+      .def_readonly("depth_path", &io::Association::depth_path);
+  m.def(
+      "read_associations", [](const py::handle& path) { return io::readAssociations(pathFrom(path)); }, py::arg("path"),
+      "A TUM association file; paths resolved against the file's folder.");
+}
+
+}  // namespace
+
+void bindIo(py::module_& m) {
+  bindTrajectory(m);
+  bindFiles(m);
+}
+
+}  // namespace ellreloc::python

@@ -1,0 +1,170 @@
+"""Relocalization from Python: the command line's poses, threads, the refiner, bad input."""
+
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import ellreloc as E
+
+
+def python_trajectory(path, frames, results):
+    E.write_trajectory(path, [E.StampedPose(f.timestamp, r.pose, f.timestamp_text)
+                              for f, r in zip(frames, results) if r.status == E.RelocalizationStatus.success])
+    return path.read_bytes()
+
+
+@pytest.mark.parametrize("method", ["ours", "oa-slam"])
+def test_fr2_keyframes_give_exactly_the_command_line_poses(fr2, data_dir, cli, tmp_path, method):
+    camera, map_, frames = fr2
+    d = data_dir / "tum_fr2_desk"
+    subprocess.run([cli, "relocalize", "--camera", str(d / "camera.yaml"), "--map", str(d / "map.json"),
+                    "--detections", str(d / "keyframes.detections.json"), "--method", method,
+                    "--out", str(tmp_path / "cli.txt")], check=True, capture_output=True)
+    relocalizer = E.ObjectRelocalizer(map_, camera, method=method)
+    results = [relocalizer.relocalize(f) for f in frames]
+    ours = python_trajectory(tmp_path / "python.txt", frames, results)
+    assert ours == (tmp_path / "cli.txt").read_bytes()
+    assert ours.count(b"\n") > 90  # most keyframes relocalize
+
+
+def test_relocalize_frames_on_threads_equals_one_by_one(fr2):
+    camera, map_, frames = fr2
+    relocalizer = E.ObjectRelocalizer(map_, camera)
+    subset = frames[::6]
+    one_by_one = [relocalizer.relocalize(f) for f in subset]
+    batch = relocalizer.relocalize_frames(subset, threads=2)
+    for a, b in zip(one_by_one, batch):
+        assert a.status == b.status
+        if a.pose is not None:
+            assert np.array_equal(a.T_wc, b.T_wc)
+            assert [(m.observation, m.object) for m in a.matches] == [(m.observation, m.object) for m in b.matches]
+
+
+def test_simulated_frames_relocalize_near_the_truth(office):
+    scene, camera, map_ = office
+    relocalizer = E.ObjectRelocalizer(map_, camera)
+    errors = []
+    for i, truth in enumerate(E.sim.query_trajectory(scene, 10, seed=5)):
+        observations, objects = E.sim.observe_map(map_, camera, truth, centre_sigma_px=1.0, axis_sigma=0.02, seed=i)
+        r = relocalizer.relocalize(observations)
+        errors.append(E.pose_error(r.pose, truth) if r.pose is not None else None)
+        if r.success:
+            assert r.T_wc.shape == (4, 4) and r.score > 2.3 and 0 < r.mean_overlap <= 1
+            for m in r.matches:  # matches pair observations with the objects that made them
+                assert m.object == objects[m.observation]
+    summary = E.summarize(errors)
+    assert summary.valid >= 8 and summary.median_position_cm < 5.0
+
+
+def test_scoring_refining_and_the_refiner(office):
+    scene, camera, map_ = office
+    truth = E.sim.query_trajectory(scene, 3, seed=2)[1]
+    observations, objects = E.sim.observe_map(map_, camera, truth)
+    relocalizer = E.ObjectRelocalizer(map_, camera)
+    scored = relocalizer.score_pose(observations, truth)
+    assert scored.success and len(scored.matches) == len(observations)
+    shift = np.eye(4)
+    shift[:3, 3] = [0.05, -0.04, 0.03]
+    start = E.Pose.from_T_wc(truth.T_wc @ shift)
+    refined = relocalizer.refine_from(observations, start)
+    assert E.pose_error(refined.pose, truth).position_cm < 0.5
+    matches = [(o.ellipse, map_.objects[j].ellipsoid) for o, j in zip(observations, objects)]
+    result = E.refine_pose(camera, start, matches)
+    assert result.final_cost < result.initial_cost and not result.fell_back
+    assert E.pose_error(result.pose, truth).position_cm < 0.5
+    X = np.array([[0.1, 0.2, 0.5], [1.0, -0.5, 0.8], [-0.7, 0.4, 1.1], [0.3, 0.9, 0.2]])
+    uv = np.array([camera.project(x) for x in truth.transform(X)])
+    with_points = E.refine_pose(camera, start, matches[:1], points_2d=uv, points_3d=X)
+    assert E.pose_error(with_points.pose, truth).position_cm < 0.5
+    with pytest.raises(ValueError, match="points_2d, points_3d: give both or neither"):
+        E.refine_pose(camera, start, matches, points_2d=uv)
+
+
+def test_keypoints_as_array_or_list_and_gravity(office):
+    scene, camera, map_ = office
+    truth = E.sim.query_trajectory(scene, 4, seed=9)[2]
+    frame = E.sim.render(scene, camera, truth)
+    keypoints = E.sim.keypoints(scene, frame, camera, truth, noise="none", seed=1)
+    assert keypoints
+    observations, _ = E.sim.observe_map(map_, camera, truth)
+    relocalizer = E.ObjectRelocalizer(E.ObjectMap(map_.objects, scene.points), camera)
+    as_list = relocalizer.relocalize(observations, keypoints=keypoints)
+    array = np.array([[k.point_index, *k.uv] for k in keypoints])
+    as_array = relocalizer.relocalize(observations, keypoints=array)
+    assert np.array_equal(as_list.T_wc, as_array.T_wc)
+    gravity = E.GravityPrior.at_pose(truth)
+    assert gravity.error_deg(truth) == pytest.approx(0.0, abs=1e-9)
+    one = relocalizer.relocalize(observations[:1], gravity=gravity)
+    assert one.status in (E.RelocalizationStatus.not_enough_observations, E.RelocalizationStatus.success)
+
+
+def test_the_gil_is_released_while_relocalizing(fr2):
+    """With a switch interval of 1000 s a thread holding the GIL is never preempted: the main
+    thread can only run while the worker is inside relocalize() if the call released the GIL."""
+    import sys
+    camera, map_, frames = fr2
+    preset = E.ObjectRelocalizer(map_, camera, method="oa-slam")
+    big = max(frames, key=lambda f: len(f.detections))  # the exhaustive search takes a while here
+    seen_inside = []
+    in_call = threading.Event()
+    state = {"inside": False}
+
+    def worker():
+        state["inside"] = True
+        in_call.set()
+        preset.relocalize(big)
+        state["inside"] = False
+
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(1000)
+    try:
+        t = threading.Thread(target=worker)
+        t.start()
+        in_call.wait()
+        seen_inside.append(state["inside"])
+        t.join()
+    finally:
+        sys.setswitchinterval(old)
+    assert seen_inside == [True]
+
+
+def test_python_threads_give_the_serial_results(fr2):
+    from concurrent.futures import ThreadPoolExecutor
+    camera, map_, frames = fr2
+    relocalizer = E.ObjectRelocalizer(map_, camera)
+    subset = frames[:24]
+    serial = [relocalizer.relocalize(f) for f in subset]
+    with ThreadPoolExecutor(2) as pool:
+        parallel = list(pool.map(relocalizer.relocalize, subset))
+    assert [r.status for r in serial] == [r.status for r in parallel]
+    assert all(a.pose is None or np.array_equal(a.T_wc, b.T_wc) for a, b in zip(serial, parallel))
+
+
+def test_options_and_bad_input_are_refused_clearly(fr2):
+    camera, map_, frames = fr2
+    with pytest.raises(ValueError, match=r"options: scoring.min_overlap is not in \[0, 1\]"):
+        E.ObjectRelocalizer(map_, camera, scoring={"min_overlap": 2.0})
+    with pytest.raises(TypeError, match="unknown option scoring.overlap_min"):
+        E.ObjectRelocalizer(map_, camera, scoring={"overlap_min": 0.2})
+    with pytest.raises(TypeError, match="unknown option group 'scorin'"):
+        E.ObjectRelocalizer(map_, camera, scorin={})
+    with pytest.raises(ValueError, match="method: expected 'ours' or 'oa-slam'"):
+        E.ObjectRelocalizer(map_, camera, method="orb")
+    with pytest.raises(ValueError, match="policy: expected 'paper'"):
+        E.ObjectRelocalizer(map_, camera, policy="boxes")
+    relocalizer = E.ObjectRelocalizer(map_, camera, acceptance={"enabled": False}, policy="bbox",
+                                      search={"budget": E.SearchBudget()})
+    assert not relocalizer.options.acceptance.enabled and relocalizer.policy == E.ObservationPolicy.bbox
+    options = E.RelocalizerOptions()
+    options.scoring.min_overlap = 0.3  # nested fields are writable in place
+    assert E.ObjectRelocalizer(map_, camera, options).options.scoring.min_overlap == 0.3
+    with pytest.raises(ValueError, match="frame: expected a DetectionFrame or a list"):
+        relocalizer.relocalize("frame.png")
+    with pytest.raises(ValueError, match="frame: expected Observation or Detection items, found a int"):
+        relocalizer.relocalize([1, 2])
+    with pytest.raises(ValueError, match=r"keypoints \(point_index, u, v\): expected shape \(N, 3\)"):
+        relocalizer.relocalize(frames[0], keypoints=np.zeros((4, 2)))
+    empty = relocalizer.relocalize([])
+    assert empty.status == E.RelocalizationStatus.not_enough_observations and empty.pose is None and empty.T_wc is None
