@@ -280,7 +280,7 @@ void bindGeometryFunctions(py::module_& m) {
         "2-Wasserstein distance (px) between the ellipses' Gaussians; inf for invalid ellipses.");
   m.def(
       "wasserstein_squared", [](const Ellipse& a, const Ellipse& b) { return wasserstein2Squared(a, b); }, py::arg("a"),
-      py::arg("b"));
+      py::arg("b"), "The squared 2-Wasserstein distance (px^2), what the refiner minimises.");
   m.def("bhattacharyya", &bhattacharyya, py::arg("a"), py::arg("b"),
         "Bhattacharyya distance between the ellipses' Gaussians.");
   m.def("iou", &ellipseIoU, py::arg("a"), py::arg("b"), py::arg("vertices") = 128,
@@ -319,7 +319,8 @@ void bindEvaluation(py::module_& m) {
       .def("__repr__", [](const PoseError& e) {
         return format("PoseError(position_cm=%.4g, rotation_deg=%.4g)", e.position_cm, e.rotation_deg);
       });
-  m.def("pose_error", &poseError, py::arg("estimate"), py::arg("truth"));
+  m.def("pose_error", &poseError, py::arg("estimate"), py::arg("truth"),
+        "Distance between the camera centres (cm) and angle between the rotations (deg).");
   py::class_<RelocalizationSummary>(
       m, "Summary", "A row of the paper's Table I: every query frame counts, medians over valid frames.")
       .def_readonly("frames", &RelocalizationSummary::frames)

@@ -154,15 +154,14 @@ void bindDetections(py::module_& m) {
           [](Keypoint& k, const py::handle& h) { k.uv = vector<2>(h, "uv"); });
 
   py::class_<DetectionFrame>(m, "DetectionFrame", "One image's detections (and keypoints), named by its file.")
-      .def(py::init([](std::string file_name, const py::handle& detections, std::vector<Keypoint> keypoints) {
+      .def(py::init([](std::string file_name, const py::handle& detections, const py::handle& keypoints) {
              DetectionFrame f;
              f.file_name = std::move(file_name);
              f.detections = detectionList(detections, "detections");
-             f.keypoints = std::move(keypoints);
+             f.keypoints = keypointsFrom(keypoints);
              return f;
            }),
-           py::arg("file_name") = "", py::arg("detections") = py::list(),
-           py::arg("keypoints") = std::vector<Keypoint>{})
+           py::arg("file_name") = "", py::arg("detections") = py::list(), py::arg("keypoints") = py::list())
       .def_readwrite("file_name", &DetectionFrame::file_name)
       .def_readwrite("detections", &DetectionFrame::detections)
       .def_readwrite("keypoints", &DetectionFrame::keypoints)
@@ -254,6 +253,26 @@ RleMask maskFromObject(const py::handle& h, const std::string& name) {
   if (py::isinstance<RleMask>(h)) return h.cast<RleMask>();
   if (py::isinstance<py::dict>(h)) return maskFromCoco(h.cast<py::dict>(), name);
   return maskFromArray(h, name);
+}
+
+std::vector<Keypoint> keypointsFrom(const py::handle& h) {
+  std::vector<Keypoint> out;
+  if (py::isinstance<py::array>(h)) {
+    for (const Eigen::Vector3d& row : rows<3>(h, "keypoints (point_index, u, v)")) {
+      if (row(0) < 0 || row(0) != std::floor(row(0)))
+        badArgument("keypoints", "point indices must be whole numbers >= 0");
+      out.push_back({static_cast<int>(row(0)), row.tail<2>()});
+    }
+    return out;
+  }
+  if (py::isinstance<py::str>(h) || !py::hasattr(h, "__iter__"))
+    badArgument("keypoints", "expected Keypoint items or an (n, 3) array, got " + describe(h));
+  for (const py::handle& item : h) {
+    if (!py::isinstance<Keypoint>(item))
+      badArgument("keypoints", "expected Keypoint items or an (n, 3) array, found " + describe(item));
+    out.push_back(item.cast<Keypoint>());
+  }
+  return out;
 }
 
 std::vector<Detection> detectionList(const py::handle& h, const std::string& name) {

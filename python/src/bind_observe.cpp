@@ -167,7 +167,8 @@ void bindFunctions(py::module_& m) {
         return fitMaskEllipse(rle, method, verdict ? &*verdict : nullptr);
       },
       py::arg("mask"), py::arg("method") = MaskFitMethod::Moments,
-      "An ellipse fitted to a mask; None when the fit fails (empty mask, or quadrilateral on a non-regular mask).");
+      "An ellipse fitted to a mask; None when the fit fails (an empty mask). quadrilateral uses the mask's "
+      "four-corner reduction, which describes regular masks only (test_regular_mask).");
 }
 
 }  // namespace

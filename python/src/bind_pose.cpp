@@ -79,24 +79,6 @@ Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optio
   return Relocalizer{ObjectRelocalizer(std::move(map), K, options), observe, method};
 }
 
-std::vector<Keypoint> keypointsFrom(const py::handle& h) {
-  std::vector<Keypoint> out;
-  if (py::isinstance<py::array>(h)) {
-    for (const Eigen::Vector3d& row : rows<3>(h, "keypoints (point_index, u, v)")) {
-      if (row(0) < 0 || row(0) != std::floor(row(0)))
-        badArgument("keypoints", "point indices must be whole numbers >= 0");
-      out.push_back({static_cast<int>(row(0)), row.tail<2>()});
-    }
-    return out;
-  }
-  for (const py::handle& item : h) {
-    if (!py::isinstance<Keypoint>(item))
-      badArgument("keypoints", "expected Keypoint items or an (n, 3) array, found " + describe(item));
-    out.push_back(item.cast<Keypoint>());
-  }
-  return out;
-}
-
 /// Observations from a DetectionFrame (observed with the relocalizer's policy), a list of
 /// Detection (likewise) or a list of Observation; a frame also gives its keypoints.
 std::vector<Observation> observationsFrom(const Relocalizer& r, const py::handle& h, std::vector<Keypoint>* keypoints) {
@@ -371,8 +353,8 @@ void bindRelocalizer(py::module_& m) {
       .def("relocalize_frames", &relocalizeMany, py::arg("frames"), py::arg("threads") = 1,
            "Relocalizes many DetectionFrames in C++ on `threads` threads; the same results as relocalize() on each.")
       .def(
-          "observe", [](const Relocalizer& r, const DetectionFrame& f) { return r.observations(f); }, py::arg("frame"),
-          "The observations relocalize() makes of a frame.")
+          "observe", [](const Relocalizer& r, const py::handle& frame) { return observationsFrom(r, frame, nullptr); },
+          py::arg("frame"), "The observations relocalize() makes of a frame.")
       .def(
           "score_pose",
           [](const Relocalizer& r, const py::handle& frame, const Pose& pose) {

@@ -27,6 +27,9 @@ void bindSim(py::module_& sim);
 /// str, bytes or list}) or an RleMask; ValueError naming `name` otherwise (bind_data.cpp).
 RleMask maskFromObject(const py::handle& h, const std::string& name);
 
+/// Keypoints from Keypoint items or an (n, 3) array of (point_index, u, v) (bind_data.cpp).
+std::vector<Keypoint> keypointsFrom(const py::handle& h);
+
 /// Detections from a list of Detection; ValueError naming `name` otherwise (bind_data.cpp).
 std::vector<Detection> detectionList(const py::handle& h, const std::string& name);
 

@@ -1,0 +1,159 @@
+"""Files and mapping from Python: round trips, errors as exceptions, maps equal to the command line's."""
+
+import os
+import subprocess
+import warnings
+
+import numpy as np
+import pytest
+
+import ellreloc as E
+
+
+def test_camera_and_trajectory_round_trips(fr2, data_dir, tmp_path):
+    camera = fr2[0]
+    for name in ("camera.json", "camera.yaml"):
+        E.write_camera(tmp_path / name, camera)
+        back = E.read_camera(str(tmp_path / name))
+        assert (back.fx, back.fy, back.cx, back.cy, back.width, back.height) == \
+            (camera.fx, camera.fy, camera.cx, camera.cy, camera.width, camera.height)
+    truth = E.read_trajectory(data_dir / "tum_fr2_desk" / "keyframes.groundtruth.txt")
+    assert len(truth) == 198 and truth[0].stamp
+    E.write_trajectory(tmp_path / "a.txt", truth)
+    again = E.read_trajectory(tmp_path / "a.txt")
+    assert [p.stamp for p in again] == [p.stamp for p in truth]  # timestamps exactly as read
+    for a, b in zip(again, truth):
+        np.testing.assert_allclose(a.pose.T_cw, b.pose.T_cw, atol=1e-12)
+    E.write_trajectory(tmp_path / "c.txt", [(p.timestamp, p.pose) for p in truth[:3]])
+    assert [p.timestamp for p in E.read_trajectory(tmp_path / "c.txt")] == [p.timestamp for p in truth[:3]]
+    assert E.find_nearest(truth, truth[5].timestamp + 0.01) == 5 and E.find_nearest(truth, 0.0) is None
+    with pytest.raises(ValueError, match="refusing to write two poses at timestamp"):
+        E.write_trajectory(tmp_path / "d.txt", [("1.0", truth[0].pose), ("1.0", truth[1].pose)])
+    assert not (tmp_path / "d.txt").exists()
+
+
+def test_maps_and_detections_round_trip(fr2, data_dir, tmp_path):
+    _, map_, frames = fr2
+    E.write_map(tmp_path / "map.json", map_)
+    back = E.read_map(tmp_path / "map.json")
+    assert [o.id for o in back.objects] == [o.id for o in map_.objects]
+    for a, b in zip(back.objects, map_.objects):
+        np.testing.assert_allclose(a.ellipsoid.dual_quadric(), b.ellipsoid.dual_quadric(), rtol=1e-12, atol=1e-12)
+    mask = np.zeros((480, 640), bool)
+    mask[100:200, 50:300] = True
+    frame = E.DetectionFrame("rgb/1.5.png", [E.Detection(62, [50, 100, 300, 200], 0.9, mask=mask),
+                                            E.Detection(41, E.Box(1, 2, 30, 40), polygon=[[1, 2], [30, 2], [30, 40]])])
+    E.write_detections(tmp_path / "d.json", frames[:2] + [frame])
+    read = E.read_detections(tmp_path / "d.json")
+    assert [len(f.detections) for f in read] == [len(f.detections) for f in frames[:2]] + [2]
+    assert np.array_equal(read[2].detections[0].mask.to_array(), mask)
+    assert read[2].detections[1].polygon.tolist() == [[1, 2], [30, 2], [30, 40]]
+    assert read[2].timestamp == 1.5 and read[2].timestamp_text == "1.5"
+
+
+def test_file_errors_are_oserror_and_content_errors_valueerror(tmp_path):
+    with pytest.raises(OSError, match="nothing.json: cannot open: No such file"):
+        E.read_map(tmp_path / "nothing.json")
+    with pytest.raises(OSError, match="is a directory"):
+        E.read_detections(tmp_path)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"objects": [{"id": 1}]}')
+    with pytest.raises(ValueError, match="bad.json: "):
+        E.read_map(bad)
+    with pytest.raises(ValueError, match="path: expected a str or os.PathLike, got a int"):
+        E.read_camera(3)
+    ok = E.MapObject(1, 41, E.Ellipsoid([0, 0, 1], [0.1, 0.1, 0.2]))
+    flat = E.MapObject(2, 41, E.Ellipsoid([1, 0, 1], [0.1, 0.1, 1e-5]))
+    E.write_map(tmp_path / "m.json", E.ObjectMap([ok, flat]))
+    with pytest.warns(UserWarning, match="object 2 left out: semi-axis 1e-05 m is below 1 mm"):
+        kept = E.read_map(tmp_path / "m.json")
+    assert [o.id for o in kept.objects] == [1]
+    assert "below 1 mm" in flat.problem() and ok.problem() == ""
+
+
+def test_depth_pngs(data_dir):
+    d = data_dir / "tum_fr3_cabinet"
+    associations = E.read_associations(d / "associate.txt")
+    depth = E.read_depth_png(associations[0].depth_path)
+    assert depth.dtype == np.float32 and depth.shape == (480, 640)
+    units = depth.astype(np.float64) * 5000
+    assert np.abs(units - np.round(units)).max() < 1e-3 and 0.3 < np.median(depth[depth > 0]) < 8
+
+
+def mapping_inputs(folder):
+    """What `ellreloc map` pairs up for each frame: its pose and depth file (same colour image)."""
+    trajectory = E.read_trajectory(folder / "trajectory.txt")
+    associations = {os.path.normpath(a.rgb_path): a for a in E.read_associations(folder / "associations.txt")}
+    for frame in E.read_detections(folder / "detections.json"):
+        a = associations[os.path.normpath(str(folder / frame.file_name))]
+        yield trajectory[E.find_nearest(trajectory, a.rgb_time)].pose, frame.detections, a.depth_path
+
+
+def test_voxel_mapping_equals_the_command_line(cli, tmp_path):
+    scene_dir = tmp_path / "scene"
+    summary = E.sim.write_simulation(scene_dir, "office", seed=4, mapping_frames=12, query_frames=2, write_rgb=False)
+    assert "map_groundtruth.json" in summary.files and summary.mapping_frames == 12
+    m = scene_dir / "mapping"
+    subprocess.run([cli, "map", "--camera", str(scene_dir / "camera.yaml"), "--associations", str(m / "associations.txt"),
+                    "--trajectory", str(m / "trajectory.txt"), "--detections", str(m / "detections.json"),
+                    "--mode", "voxel", "--out", str(tmp_path / "cli.json")], check=True, capture_output=True)
+    camera = E.read_camera(scene_dir / "camera.yaml")
+    floats, units = E.Mapper(camera), E.Mapper(camera, mode="voxel")
+    for pose, detections, depth_path in mapping_inputs(m):
+        depth = E.read_depth_png(depth_path)
+        report = floats.add_keyframe(pose, detections, depth)
+        units.add_keyframe(pose, detections, np.round(depth.astype(np.float64) * 5000).astype(np.uint16))
+        assert report.used > 0
+    floats.finish()
+    E.write_map(tmp_path / "python.json", floats.map())
+    E.write_map(tmp_path / "units.json", units.map())
+    assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert (tmp_path / "units.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert floats.stats.keyframes == 12 and len(floats.map()) >= 8
+    truth = E.read_map(scene_dir / "map_groundtruth.json")
+    posed = [(pose, dets) for pose, dets, _ in mapping_inputs(m)]
+    exact = E.map_quality(truth, camera, posed)
+    moved = E.map_quality(E.sim.perturb_map(truth, "hard", seed=1), camera, posed)
+    built = E.map_quality(floats.map(), camera, posed)
+    assert exact.frames == 12 and exact.boxes == sum(len(d) for _, d in posed)
+    assert exact.median_best_iou > moved.median_best_iou and built.median_best_iou > 0.4
+
+
+def test_box_mapping_of_real_frames_equals_the_command_line(data_dir, cli, tmp_path):
+    d = data_dir / "tum_fr3_office_first_half"
+    frames = E.read_detections(d / "detections.json")[:600:4]
+    (tmp_path / "rgb").mkdir()
+    E.write_detections(tmp_path / "detections.json", frames)
+    subprocess.run([cli, "map", "--camera", str(d / "camera.yaml"), "--trajectory", str(d / "groundtruth.txt"),
+                    "--detections", str(tmp_path / "detections.json"), "--mode", "boxes",
+                    "--out", str(tmp_path / "cli.json")], check=True, capture_output=True)
+    camera = E.read_camera(d / "camera.yaml")
+    truth = E.read_trajectory(d / "groundtruth.txt")
+    mapper = E.Mapper(camera, mode=E.MappingMode.boxes)
+    for f in frames:
+        k = E.find_nearest(truth, f.timestamp)
+        if k is not None:
+            mapper.add_keyframe(truth[k].pose, f.detections)
+    mapper.finish()
+    E.write_map(tmp_path / "python.json", mapper.map())
+    assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+
+
+def test_mapper_refuses_bad_keyframes(office):
+    _, camera, _ = office
+    mapper = E.Mapper(camera)
+    pose = E.Pose.look_at([2, 0, 1.4], [0, 0, 0.5])
+    det = [E.Detection(41, [10, 10, 50, 50])]
+    with pytest.raises(ValueError, match="depth: is 20x10 pixels, the camera 640x480"):
+        mapper.add_keyframe(pose, det, np.zeros((10, 20), np.float32))
+    with pytest.raises(ValueError, match="depth: expected a 2-D uint16 or float numpy array, got a int32 array"):
+        mapper.add_keyframe(pose, det, np.zeros((480, 640), np.int32))
+    with pytest.raises(ValueError, match="depth"):
+        mapper.add_keyframe(pose, det)  # voxel mode needs the depth
+    with pytest.raises(ValueError, match="mode: expected 'voxel' or 'boxes'"):
+        E.Mapper(camera, mode="rgbd")
+    options = E.MapperOptions()
+    options.min_observations = 0
+    with pytest.raises(ValueError, match="min_observations"):
+        E.Mapper(camera, options)
+    assert mapper.stats.keyframes == 0

@@ -1,0 +1,57 @@
+"""The package as a user meets it: stubs that match the module, docstrings, the example script."""
+
+import inspect
+import os
+import pathlib
+import re
+import subprocess
+import sys
+
+import pytest
+
+import ellreloc
+from ellreloc import _ellreloc
+
+PACKAGE = pathlib.Path(ellreloc.__file__).parent
+
+
+def public(module):
+    return {n for n, v in vars(module).items() if not n.startswith("_") and not inspect.ismodule(v)}
+
+
+def stub_names(path):
+    text = path.read_text()
+    return set(re.findall(r"^(?:class|def) (\w+)", text, re.M)) | set(re.findall(r"^(\w+): ", text, re.M))
+
+
+@pytest.mark.parametrize("module, stub", [(_ellreloc, "_ellreloc.pyi"), (ellreloc.sim, "sim.pyi")])
+def test_stubs_name_every_public_name_and_nothing_else(module, stub):
+    assert stub_names(PACKAGE / stub) == public(module)
+
+
+def test_stub_members_exist():
+    """Each `def` or attribute in a stubbed class exists on the class."""
+    for stub, module in (("_ellreloc.pyi", _ellreloc), ("sim.pyi", ellreloc.sim)):
+        cls = None
+        for line in (PACKAGE / stub).read_text().splitlines():
+            if m := re.match(r"class (\w+)", line):
+                cls = getattr(module, m.group(1))
+            elif cls is not None and (m := re.match(r"    (?:def )?(\w+)\b", line)):
+                if m.group(1) not in ("pass",) and not line.strip().startswith(("#", "@", '"""')):
+                    assert hasattr(cls, m.group(1)), f"{stub}: {cls.__name__}.{m.group(1)}"
+            elif line and not line.startswith(" "):
+                cls = None
+
+
+def test_every_function_and_class_has_a_docstring_or_is_plain_data():
+    missing = [n for n in public(_ellreloc) if inspect.isroutine(getattr(_ellreloc, n))
+               and not (getattr(_ellreloc, n).__doc__ or "").split("\n", 1)[-1].strip()]
+    assert not missing, missing
+
+
+def test_the_example_relocalizes_fr2(data_dir):
+    example = pathlib.Path(os.environ.get("ELLRELOC_EXAMPLES", pathlib.Path(__file__).parents[2] / "examples" / "python"))
+    env = dict(os.environ, PYTHONPATH=str(PACKAGE.parent))
+    out = subprocess.run([sys.executable, str(example / "relocalize.py"), str(data_dir / "tum_fr2_desk")],
+                         check=True, capture_output=True, text=True, env=env).stdout
+    assert "camera centre" in out and "observation" in out
