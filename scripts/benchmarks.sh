@@ -48,6 +48,12 @@ fi
 table real_data python3 scripts/real_data.py "$build"
 table observe_accuracy "$bin/observe_accuracy"
 table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
+python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt")
+if [ -d "$build/python/ellreloc" ] && [ -n "$python" ]; then
+  table python_overhead env PYTHONPATH="$build/python" "$python" benchmarks/python_overhead.py
+else
+  echo "benchmarks: python_overhead skipped (no Python bindings in $build)" >&2
+fi
 
 python3 scripts/benchmark_tables.py "$out" docs/benchmarks.md "$(nproc)"
 echo "benchmarks: docs/benchmarks.md rewritten from $out" >&2
