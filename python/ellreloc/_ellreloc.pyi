@@ -238,6 +238,7 @@ class Mapper:
     def map(self) -> ObjectMap: """The current object map."""
     stats: MapperStats
     camera: Intrinsics
+    options: MapperOptions
 
 
 class MapperOptions:

@@ -128,7 +128,8 @@ void bindMapperClass(py::module_& m) {
            "Boxes mode: refits every object whose views grew. Call after the last keyframe.")
       .def("map", &Mapper::map, py::call_guard<py::gil_scoped_release>(), "The current object map.")
       .def_property_readonly("stats", &Mapper::stats)
-      .def_property_readonly("camera", &Mapper::intrinsics);
+      .def_property_readonly("camera", &Mapper::intrinsics)
+      .def_property_readonly("options", &Mapper::options, "A copy.");
 }
 
 }  // namespace
