@@ -70,7 +70,7 @@ class Detection:
 
 
 class DetectionFrame:
-    """One image's detections (and keypoints), named by its file."""
+    """One image's detections (and keypoints), named by its file. `detections` and `keypoints` return copies: assign a new list to change them."""
     def __init__(self, file_name: str = ..., detections: Sequence[Detection] = ..., keypoints: Sequence[Keypoint] | ArrayLike = ...) -> None: ...
     file_name: str
     detections: list[Detection]

@@ -15,25 +15,28 @@ namespace {
 RleMask maskFromCoco(const py::dict& d, const std::string& name) {
   if (!d.contains("size") || !d.contains("counts"))
     badArgument(name, "a COCO RLE dict needs 'size' ([height, width]) and 'counts'");
-  const auto size = d["size"].cast<std::vector<long long>>();
-  if (size.size() != 2 || size[0] <= 0 || size[1] <= 0 || size[0] * size[1] > (1LL << 31))
-    badArgument(name, "'size' must be [height, width], both positive");
   RleMask rle;
-  rle.height = static_cast<int>(size[0]);
-  rle.width = static_cast<int>(size[1]);
-  const py::object counts = d["counts"];
-  if (py::isinstance<py::str>(counts) || py::isinstance<py::bytes>(counts)) {
-    const std::string text =
-        py::isinstance<py::bytes>(counts) ? counts.cast<py::bytes>().cast<std::string>() : counts.cast<std::string>();
-    auto decoded = decodeRleString(text);
-    if (!decoded) badArgument(name, "'counts' is a malformed compressed RLE string");
-    rle.counts = std::move(*decoded);
-  } else {
-    for (const py::handle& c : counts) {
-      const long long v = c.cast<long long>();
-      if (v < 0 || v > 0xffffffffLL) badArgument(name, "'counts' run lengths must be >= 0");
-      rle.counts.push_back(static_cast<uint32_t>(v));
+  try {
+    const auto size = d["size"].cast<std::vector<long long>>();
+    if (size.size() != 2 || size[0] <= 0 || size[1] <= 0 || size[0] * size[1] > (1LL << 31))
+      badArgument(name, "'size' must be [height, width], both positive");
+    rle.height = static_cast<int>(size[0]);
+    rle.width = static_cast<int>(size[1]);
+    const py::object counts = d["counts"];
+    if (py::isinstance<py::str>(counts) || py::isinstance<py::bytes>(counts)) {
+      const std::string text =
+          py::isinstance<py::bytes>(counts) ? counts.cast<py::bytes>().cast<std::string>() : counts.cast<std::string>();
+      auto decoded = decodeRleString(text);
+      if (!decoded) badArgument(name, "'counts' is a malformed compressed RLE string");
+      rle.counts = std::move(*decoded);
+    } else {
+      for (const long long v : counts.cast<std::vector<long long>>()) {
+        if (v < 0 || v > 0xffffffffLL) badArgument(name, "'counts' run lengths must be >= 0");
+        rle.counts.push_back(static_cast<uint32_t>(v));
+      }
     }
+  } catch (const py::cast_error&) {
+    badArgument(name, "'size' must be two integers and 'counts' a string, bytes or a list of integers");
   }
   return rle;
 }
@@ -153,7 +156,10 @@ void bindDetections(py::module_& m) {
           "uv", [](const Keypoint& k) { return toArray(k.uv); },
           [](Keypoint& k, const py::handle& h) { k.uv = vector<2>(h, "uv"); });
 
-  py::class_<DetectionFrame>(m, "DetectionFrame", "One image's detections (and keypoints), named by its file.")
+  py::class_<DetectionFrame>(
+      m, "DetectionFrame",
+      "One image's detections (and keypoints), named by its file. `detections` and `keypoints` return "
+      "copies: assign a new list to change them.")
       .def(py::init([](std::string file_name, const py::handle& detections, const py::handle& keypoints) {
              DetectionFrame f;
              f.file_name = std::move(file_name);

@@ -36,6 +36,13 @@ sim::NoiseModel noiseFrom(const py::handle& h) {
   return sim::NoiseModel::preset(noiseLevelFrom(h));
 }
 
+/// An array that shares the frame's memory (its base keeps the frame alive), made read-only.
+template <typename T>
+py::array_t<T> readOnlyView(py::array_t<T> view) {
+  view.attr("setflags")(py::arg("write") = false);
+  return view;
+}
+
 void bindScene(py::module_& s) {
   py::enum_<sim::ScenePreset>(s, "ScenePreset")
       .value("office", sim::ScenePreset::Office, "~20 objects of varied categories")
@@ -63,16 +70,18 @@ void bindRendering(py::module_& s) {
       .def_readonly("height", &sim::RenderedFrame::height)
       .def_property_readonly(
           "depth",
-          [](const sim::RenderedFrame& f) {
-            return py::array_t<float>({f.height, f.width}, f.depth.data());
+          [](const py::object& self) {
+            const auto& f = self.cast<const sim::RenderedFrame&>();
+            return readOnlyView(py::array_t<float>({f.height, f.width}, f.depth.data(), self));
           },
-          "(height, width) float32 metres along the optical axis; 0 = no surface.")
+          "(height, width) float32 metres along the optical axis; 0 = no surface. A read-only view of the frame.")
       .def_property_readonly(
           "instance",
-          [](const sim::RenderedFrame& f) {
-            return py::array_t<int16_t>({f.height, f.width}, f.instance.data());
+          [](const py::object& self) {
+            const auto& f = self.cast<const sim::RenderedFrame&>();
+            return readOnlyView(py::array_t<int16_t>({f.height, f.width}, f.instance.data(), self));
           },
-          "(height, width) int16: the object index of each pixel, -1 for none.")
+          "(height, width) int16: the object index of each pixel, -1 for none. A read-only view of the frame.")
       .def_readonly("masks", &sim::RenderedFrame::masks, "per object: its visible pixels as an RleMask")
       .def_readonly("boxes", &sim::RenderedFrame::boxes, "per object: the box of its visible pixels")
       .def_readonly("visible_pixels", &sim::RenderedFrame::visible_pixels);

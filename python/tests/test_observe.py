@@ -52,6 +52,8 @@ def test_mask_errors_name_what_is_wrong():
         E.observation_from_mask([[0, 1], [1, 0]])
     with pytest.raises(ValueError, match="malformed compressed RLE string"):
         E.RleMask.from_coco({"size": [4, 4], "counts": "\x01"})
+    with pytest.raises(ValueError, match="'size' must be two integers"):
+        E.RleMask.from_coco({"size": "4x4", "counts": [16]})
     with pytest.raises(ValueError, match="needs 'size'"):
         E.Detection(0, [0, 0, 1, 1], mask={"counts": []})
     with pytest.raises(ValueError, match="runs do not add up"):

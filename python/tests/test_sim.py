@@ -19,6 +19,7 @@ def test_rendering_masks_boxes_and_depth_agree(office):
     frame = E.sim.render(scene, camera, pose)
     assert frame.depth.shape == frame.instance.shape == (480, 640)
     assert frame.depth.dtype == np.float32 and frame.instance.dtype == np.int16
+    assert not frame.depth.flags.writeable and frame.depth.base is not None  # a view, not a copy
     seen = 0
     for i in range(scene.object_count):
         pixels = frame.instance == i
