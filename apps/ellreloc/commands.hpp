@@ -3,13 +3,16 @@
 // function runs it (so that `demo` can chain them). Each throws ellreloc::Error on bad input
 // (main turns it into one line and exit code 2).
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "ellreloc/core/evaluation.hpp"
+#include "ellreloc/core/object_map.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
+#include "figure.hpp"
 
 namespace CLI {
 class App;
@@ -72,6 +75,7 @@ struct RelocalizeArgs {
   bool accept_all = false;
   std::vector<double> camera_up, map_up;  ///< a gravity prior for every frame, when both are given
   double gravity_sigma_deg = 2.0;
+  std::string overlays;  ///< a folder for one PNG per frame (io/overlay.hpp); empty: none
 };
 /// `use_points` is set after parsing, from whether --points was given.
 CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a);
@@ -79,11 +83,40 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a);
 int relocalize(const RelocalizeArgs& a, const Console& console);
 
 struct EvaluateArgs {
-  std::string groundtruth, estimate, detections, plot;
+  std::string groundtruth;
+  std::vector<std::string> estimates;  ///< FILE or FILE:LABEL
+  std::string detections, plot, map, per_frame;
+};
+/// One method's errors on the query frames.
+struct MethodEvaluation {
+  std::string label, path;
+  std::vector<std::optional<PoseError>> errors;         ///< per query frame; nullopt: no pose
+  std::vector<std::optional<Eigen::Vector3d>> centres;  ///< per query frame: the estimated camera centre
+  RelocalizationSummary summary;
+};
+struct Evaluation {
+  std::vector<std::string> frames;     ///< the query frames' timestamps as written
+  std::vector<Eigen::Vector3d> truth;  ///< their true camera centres
+  std::vector<MethodEvaluation> methods;
 };
 CLI::App* addEvaluateCommand(CLI::App& app, EvaluateArgs& a);
-RelocalizationSummary evaluate(const EvaluateArgs& a);
-void printEvaluation(const RelocalizationSummary& e);
+/// Reads and scores every estimate; writes nothing.
+Evaluation evaluateEstimates(const EvaluateArgs& a);
+/// evaluateEstimates, then --plot and --per-frame.
+Evaluation evaluate(const EvaluateArgs& a);
+/// The Table-I rows, one per method (the method is the last column).
+void printEvaluation(const Evaluation& e);
+/// Cumulative position and rotation error curves of every method and a top view (plots.cpp).
+Figure comparisonFigure(const Evaluation& e, const ObjectMap* map);
+
+struct ReportArgs {
+  std::string groundtruth;
+  std::vector<std::string> estimates;  ///< FILE or FILE:LABEL
+  std::string detections, map, overlays, out;
+  int worst = 6;
+};
+CLI::App* addReportCommand(CLI::App& app, ReportArgs& a);
+void report(const ReportArgs& a, const Console& console);
 
 struct DemoArgs {
   std::string out;

@@ -13,7 +13,8 @@ namespace fs = std::filesystem;
 namespace ellreloc::cli {
 
 CLI::App* addDemoCommand(CLI::App& app, DemoArgs& a) {
-  CLI::App* d = app.add_subcommand("demo", "simulate -> map -> relocalize (ours and OA-SLAM) -> evaluate");
+  CLI::App* d =
+      app.add_subcommand("demo", "simulate -> map -> relocalize (ours and OA-SLAM) -> evaluate -> report.html");
   d->add_option("--out", a.out, "working folder (default: a folder in the system's temp directory)");
   d->add_option("--seed", a.seed, "seed of the simulated scene")->capture_default_str();
   d->add_option("--threads", a.threads, "frames relocalized in parallel")
@@ -57,15 +58,29 @@ void demo(const DemoArgs& a, const Console& console) {
     args.method = r.method;
     args.out = out;
     args.threads = a.threads;
+    if (r.map == rows[0].map && r.method == "ours") args.overlays = dir + "/overlays";
     relocalize(args, inner);
-    const RelocalizationSummary e = evaluate({dir + "/query/groundtruth.txt", out, dir + "/query/detections.json", ""});
+    EvaluateArgs ev;
+    ev.groundtruth = dir + "/query/groundtruth.txt";
+    ev.estimates = {out};
+    ev.detections = dir + "/query/detections.json";
+    const RelocalizationSummary e = evaluate(ev).methods[0].summary;
     std::printf("| %s | %.1f | %.2f | %.1f | %d |\n", r.name, e.median_position_cm, e.median_rotation_deg,
                 e.validPercent(), e.relocalized - e.valid);
     std::fflush(stdout);
   }
+  // The report compares both methods on the voxel map, with the overlays of ours' worst frames.
+  ReportArgs report_args;
+  report_args.groundtruth = dir + "/query/groundtruth.txt";
+  report_args.estimates = {dir + "/poses_ours_map_voxel.txt:ours", dir + "/poses_oa-slam_map_voxel.txt:OA-SLAM"};
+  report_args.detections = dir + "/query/detections.json";
+  report_args.map = dir + "/map_voxel.json";
+  report_args.overlays = dir + "/overlays";
+  report_args.out = dir + "/report.html";
+  report(report_args, inner);
   if (!console.quiet)
-    std::printf("\nvoxel map: %zu objects; files in %s; %.0f s\n", objects, dir.c_str(),
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    std::printf("\nvoxel map: %zu objects; files in %s; report: %s; %.0f s\n", objects, dir.c_str(),
+                report_args.out.c_str(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
 }  // namespace ellreloc::cli

@@ -1,4 +1,4 @@
-// The `ellreloc` command: simulate, observe, map, relocalize, evaluate, demo.
+// The `ellreloc` command: simulate, observe, map, relocalize, evaluate, report, demo.
 // Exit codes: 0 success, 2 bad usage or bad input (one line on stderr), 1 anything else.
 
 #include <CLI/CLI.hpp>
@@ -21,12 +21,14 @@ int main(int argc, char** argv) {
   MapArgs mp;
   RelocalizeArgs rl;
   EvaluateArgs ev;
+  ReportArgs rp;
   DemoArgs dm;
   CLI::App* s = addSimulateCommand(app, sim);
   CLI::App* o = addObserveCommand(app, obs);
   CLI::App* m = addMapCommand(app, mp);
   CLI::App* r = addRelocalizeCommand(app, rl);
   CLI::App* e = addEvaluateCommand(app, ev);
+  CLI::App* p = addReportCommand(app, rp);
   CLI::App* d = addDemoCommand(app, dm);
 
   try {
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
     rl.use_points = r->get_option("--points")->count() > 0;
     if (r->parsed()) relocalize(rl, console);
     if (e->parsed()) printEvaluation(evaluate(ev));
+    if (p->parsed()) report(rp, console);
     if (d->parsed()) demo(dm, console);
   } catch (const ellreloc::Error& err) {
     std::fprintf(stderr, "ellreloc: %s\n", err.what());

@@ -3,11 +3,14 @@
 #include "ellreloc/io/map.hpp"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 
 #include "commands.hpp"
+#include "ellreloc/core/coco.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/rgbd.hpp"
@@ -36,11 +39,33 @@ std::vector<PosedDetections> posedFrames(const std::vector<DetectionFrame>& fram
 }
 
 /// Printed even when quiet: it is a result.
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
 void printQuality(const MapQuality& q) {
   std::printf(
       "map quality on %zu held-out frames: median best same-category IoU %.3f (mean %.3f) over %zu boxes, "
       "%zu overlap an object of their category\n",
       q.frames, q.median_best_iou, q.mean_best_iou, q.boxes, q.explained);
+}
+
+/// Objects per category, what was left out, and the candidates that never entered the map.
+void printSummary(const ObjectMap& map, const std::vector<std::string>& dropped, const MapperStats& stats,
+                  int min_observations) {
+  std::map<int, int> per_category;
+  for (const MapObject& o : map.objects) ++per_category[o.category];
+  std::string line;
+  for (const auto& [category, count] : per_category) {
+    const char* name = cocoCategoryName(category);
+    line += (line.empty() ? "" : ", ") + std::to_string(count) + " " +
+            (name ? std::string(name) : "category " + std::to_string(category));
+  }
+  std::printf("  objects: %s\n", line.empty() ? "none" : line.c_str());
+  std::printf("  left out: %zu degenerate object(s)%s%s; %d candidate(s) seen fewer than %d times\n", dropped.size(),
+              dropped.empty() ? "" : ": ", joined(dropped).c_str(), stats.candidates, min_observations);
 }
 
 }  // namespace
@@ -144,11 +169,22 @@ void map(const MapArgs& a, const Console& console) {
   console.endProgress();
   if (used == 0) throw Error(a.detections + ": no frame has both a pose in " + a.trajectory + " and its depth");
   mapper.finish();
-  const ObjectMap result = mapper.map();
+  ObjectMap result = mapper.map();
+  // Objects relocalization could not use (mapObjectProblem) are left out of the file, and said.
+  std::vector<std::string> dropped;
+  result.objects.erase(std::remove_if(result.objects.begin(), result.objects.end(),
+                                      [&](const MapObject& o) {
+                                        const std::string why = mapObjectProblem(o);
+                                        if (!why.empty()) dropped.push_back(std::to_string(o.id) + " (" + why + ")");
+                                        return !why.empty();
+                                      }),
+                       result.objects.end());
   io::writeMap(a.out, result);
-  if (!console.quiet)
+  if (!console.quiet) {
     std::printf("wrote %s: %zu objects from %d keyframes (%s mode; %d frames without pose, %d without depth)\n",
                 a.out.c_str(), result.objects.size(), used, a.mode.c_str(), no_pose, no_depth);
+    printSummary(result, dropped, mapper.stats(), options.min_observations);
+  }
   if (!a.holdout.empty() || a.holdout_every > 0) printQuality(measureMapQuality(result, K, held_out));
 }
 

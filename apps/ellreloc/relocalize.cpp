@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/files.hpp"
 #include "ellreloc/io/map.hpp"
+#include "ellreloc/io/overlay.hpp"
 #include "ellreloc/io/trajectory.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
@@ -47,6 +49,10 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
                 "refine with keypoints matched to the map's points: from this file (same frame "
                 "layout), or from the detections file when no file is given")
       ->expected(0, 1);
+  r->add_option("--overlays", a.overlays,
+                "folder for one PNG per frame (TIMESTAMP.png): detections, the map projected with the returned pose "
+                "and the matches, the map at the --reference pose too, over the frame's image when its file_name "
+                "resolves next to the detections file");
   r->add_option("--threads", a.threads, "frames in parallel")->capture_default_str()->check(CLI::Range(1, 256));
   r->add_option("--max-time-ms", a.max_time_ms,
                 "wall-clock budget of each frame's hypothesis search in ms (0: none; results then depend on the "
@@ -230,6 +236,44 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
   return j;
 }
 
+/// The --overlays pictures, one per frame, named by the frame's timestamp.
+void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsics& K,
+                   const std::vector<DetectionFrame>& frames, const std::vector<RelocalizationResult>& results,
+                   const std::vector<std::optional<Pose>>& references, const ObserveOptions& observe_options) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(a.overlays, ec);
+  if (ec || !fs::is_directory(a.overlays)) throw FileError(a.overlays + ": cannot create the overlays folder");
+  const fs::path images = fs::path(a.detections).parent_path();
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const RelocalizationResult& r = results[i];
+    io::OverlayContent c;
+    for (const Detection& d : frames[i].detections)
+      if (const ObserveResult o = observeDetection(d, K.width, K.height, observe_options); o.observation)
+        c.observations.push_back(*o.observation);
+    const bool has_pose = r.status == RelocalizationStatus::Success || r.status == RelocalizationStatus::LowEvidence;
+    if (has_pose) c.pose = r.pose;
+    c.truth = references[i];
+    for (const ObjectCorrespondence& m : r.inliers) c.matches.emplace_back(m.observation, m.object);
+    char line[160];
+    c.text.push_back(frames[i].file_name + " (" + a.method + ")");
+    std::snprintf(line, sizeof line, "%s: %zu of %zu matched, evidence %.2f, %.1f ms", toString(r.status),
+                  r.inliers.size(), c.observations.size(), r.evidence, r.time_ms);
+    c.text.push_back(line);
+    if (has_pose && references[i]) {
+      const PoseError e = poseError(r.pose, *references[i]);
+      std::snprintf(line, sizeof line, "against --reference: %.1f cm, %.1f deg (%s)", e.position_cm, e.rotation_deg,
+                    e.valid() ? "valid" : "wrong");
+      c.text.push_back(line);
+    }
+    const fs::path image = images / frames[i].file_name;
+    std::error_code exists_ec;
+    const bool found = !frames[i].file_name.empty() && fs::is_regular_file(image, exists_ec);
+    io::writeOverlay((fs::path(a.overlays) / (frames[i].timestampText() + ".png")).string(), K, map, c,
+                     found ? image.string() : "");
+  }
+}
+
 }  // namespace
 
 int relocalize(const RelocalizeArgs& a, const Console& console) {
@@ -299,6 +343,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     if (r.status == RelocalizationStatus::Success) poses.push_back({timestamps[i], r.pose, frames[i].timestampText()});
   }
   io::writeTumTrajectory(a.out, poses);
+  if (!a.overlays.empty()) writeOverlays(a, object_map, K, frames, results, references, observe_options);
   if (!a.report.empty()) io::writeFileAtomically(a.report, report.dump(1) + "\n");
   if (!console.quiet)
     std::printf("wrote %s: %zu of %zu frames relocalized (%s), median %.1f ms per frame\n", a.out.c_str(), poses.size(),

@@ -7,6 +7,7 @@
 
 #include "ellreloc/core/box.hpp"
 #include "ellreloc/core/camera.hpp"
+#include "ellreloc/core/coco.hpp"
 #include "ellreloc/core/depth_image.hpp"
 #include "ellreloc/core/detection.hpp"
 #include "ellreloc/core/distances.hpp"

@@ -9,6 +9,7 @@
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/files.hpp"
 #include "ellreloc/io/map.hpp"
+#include "ellreloc/io/overlay.hpp"
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"

@@ -10,46 +10,13 @@
 #include <fstream>
 #include <sstream>
 
+#include "cli/cli_run.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/map.hpp"
-#include "fixtures/temp_dir.hpp"
 
 namespace {
 
-namespace fs = std::filesystem;
-
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
-
-CliRun run(const std::string& args, const ellreloc::test::TempDir& dir) {
-  const std::string out = dir.path("stdout.txt"), err = dir.path("stderr.txt");
-  const std::string cmd = std::string(ELLRELOC_CLI) + " " + args + " >" + out + " 2>" + err;
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream o(out), e(err);
-  std::stringstream so, se;
-  so << o.rdbuf();
-  se << e.rdbuf();
-  r.out = so.str();
-  r.err = se.str();
-  return r;
-}
-
-int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
-
-std::string data(const std::string& name) { return std::string(ELLRELOC_TEST_DATA_DIR) + "/" + name; }
-
-void writeFile(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using namespace ellreloc::test::cli;
 
 TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
   ellreloc::test::TempDir dir;
@@ -76,6 +43,9 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
             dir);
     ASSERT_EQ(r.code, 0) << mode << ": " << r.err;
     EXPECT_NE(r.out.find("objects from 24 keyframes"), std::string::npos) << r.out;
+    // The summary names categories and what was left out.
+    EXPECT_NE(r.out.find("\n  objects: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\n  left out: 0 degenerate object(s); "), std::string::npos) << r.out;
   }
   for (const std::string method : {"ours", "oa-slam"}) {
     r = run("relocalize --camera " + s + "/camera.yaml --map " + dir.path("map_voxel.json") + " --detections " + s +
@@ -111,7 +81,7 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
               " --detections " + s + "/query/detections.json",
           dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("| - | - | 0.0 | 0 / "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| - | - | 0.0 | 0 / 12 | nothing |"), std::string::npos) << r.out;
   // Keypoints matched to the map's points, from the detections file itself.
   r = run("relocalize --camera " + s + "/camera.yaml --map " + s + "/map_perturbed.json --detections " + s +
               "/query/detections.json --points --out " + dir.path("points.txt"),
@@ -133,7 +103,7 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
   EXPECT_GT(fs::file_size(dir.path("gravity.txt")), 0u);
   r = run("--help", dir);
   EXPECT_EQ(r.code, 0);
-  for (const std::string sub : {"simulate", "observe", "map", "relocalize", "evaluate", "demo"}) {
+  for (const std::string sub : {"simulate", "observe", "map", "relocalize", "evaluate", "report", "demo"}) {
     r = run(sub + " --help", dir);
     EXPECT_EQ(r.code, 0) << sub;
     EXPECT_NE(r.out.find("Example: ellreloc " + sub), std::string::npos) << sub;

@@ -1,0 +1,102 @@
+#include "ellreloc/io/overlay.hpp"
+
+#include <cstdio>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "ellreloc/core/projection.hpp"
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/files.hpp"
+
+namespace ellreloc::io {
+
+namespace {
+
+// BGR.
+const cv::Scalar kObservation(60, 180, 60), kEstimate(0, 140, 255), kTruth(230, 120, 30), kMatch(200, 0, 200);
+
+cv::Point pixel(const Eigen::Vector2d& p) {
+  return {static_cast<int>(std::lround(p.x() * 4)), static_cast<int>(std::lround(p.y() * 4))};  // 2 fractional bits
+}
+
+void drawEllipse(cv::Mat& img, const Ellipse& e, const cv::Scalar& colour, int thickness) {
+  // OpenCV draws with sub-pixel accuracy given `shift` fractional bits; huge ellipses are clipped.
+  const double limit = 4.0 * (img.cols + img.rows);
+  if (!e.isValid() || e.axes().maxCoeff() > limit || e.center().cwiseAbs().maxCoeff() > limit) return;
+  cv::ellipse(img, pixel(e.center()), cv::Size(static_cast<int>(e.axes()(0) * 4), static_cast<int>(e.axes()(1) * 4)),
+              e.angle() * 180.0 / M_PI, 0, 360, colour, thickness, cv::LINE_AA, 2);
+}
+
+void label(cv::Mat& img, const std::string& text, cv::Point at, const cv::Scalar& colour, double scale = 0.45) {
+  cv::putText(img, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(255, 255, 255), 3, cv::LINE_AA);
+  cv::putText(img, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
+}
+
+/// Each map object's image at `pose` (nullopt when it has none or lies far outside the image).
+std::vector<std::optional<Ellipse>> projectMap(const ObjectMap& map, const Intrinsics& K, const Pose& pose) {
+  std::vector<std::optional<Ellipse>> out(map.objects.size());
+  for (size_t i = 0; i < map.objects.size(); ++i)
+    if (const Projection p = project(map.objects[i].ellipsoid, K, pose); p) out[i] = p.ellipse;
+  return out;
+}
+
+cv::Mat canvas(const Intrinsics& K, const std::string& background) {
+  if (background.empty()) return cv::Mat(K.height, K.width, CV_8UC3, cv::Scalar(245, 245, 245));
+  const std::string bytes = readTextFile(background);
+  cv::Mat img = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
+                             cv::IMREAD_COLOR);
+  if (img.empty()) throw Error(background + ": not an image OpenCV can read");
+  if (img.cols != K.width || img.rows != K.height) cv::resize(img, img, cv::Size(K.width, K.height));
+  // Lighter, so that the drawing stands out.
+  img.convertTo(img, -1, 0.6, 90);
+  return img;
+}
+
+}  // namespace
+
+void writeOverlay(const std::string& path, const Intrinsics& K, const ObjectMap& map, const OverlayContent& content,
+                  const std::string& background) {
+  cv::Mat img = canvas(K, background);
+  if (content.truth)
+    for (const std::optional<Ellipse>& e : projectMap(map, K, *content.truth))
+      if (e) drawEllipse(img, *e, kTruth, 1);
+  for (const Observation& o : content.observations) {
+    cv::rectangle(img, cv::Point2d(o.box.x1, o.box.y1), cv::Point2d(o.box.x2, o.box.y2), kObservation, 1, cv::LINE_AA);
+    drawEllipse(img, o.ellipse, kObservation, 2);
+    if (o.regular.value_or(false))
+      label(img, "R", cv::Point(static_cast<int>(o.box.x1) + 2, static_cast<int>(o.box.y1) + 14), kObservation);
+  }
+  if (content.pose) {
+    const std::vector<std::optional<Ellipse>> projected = projectMap(map, K, *content.pose);
+    for (size_t i = 0; i < projected.size(); ++i) {
+      if (!projected[i]) continue;
+      drawEllipse(img, *projected[i], kEstimate, 2);
+      const Eigen::Vector2d c = projected[i]->center();
+      if (c.x() >= 0 && c.y() >= 0 && c.x() < K.width && c.y() < K.height)
+        label(img, std::to_string(map.objects[i].id), cv::Point(static_cast<int>(c.x()) + 4, static_cast<int>(c.y())),
+              kEstimate, 0.4);
+    }
+    for (const auto& [observation, object] : content.matches) {
+      if (observation < 0 || observation >= static_cast<int>(content.observations.size()) || object < 0 ||
+          object >= static_cast<int>(projected.size()) || !projected[static_cast<size_t>(object)])
+        continue;
+      cv::line(img, pixel(content.observations[static_cast<size_t>(observation)].ellipse.center()),
+               pixel(projected[static_cast<size_t>(object)]->center()), kMatch, 2, cv::LINE_AA, 2);
+    }
+  }
+  int y = 18;
+  for (const std::string& line : content.text) {
+    label(img, line, cv::Point(8, y), cv::Scalar(0, 0, 0), 0.5);
+    y += 20;
+  }
+  const char* legend = content.truth ? "green: detections  orange: map at the pose  blue: at the true pose  magenta: "
+                                       "matches"
+                                     : "green: detections  orange: map at the pose  magenta: matches";
+  label(img, legend, cv::Point(8, K.height - 8), cv::Scalar(60, 60, 60), 0.4);
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", img, png)) throw Error(path + ": could not encode the overlay as PNG");
+  writeFileAtomically(path, std::string(png.begin(), png.end()));
+}
+
+}  // namespace ellreloc::io
