@@ -55,5 +55,7 @@ else
   echo "benchmarks: python_overhead skipped (no Python bindings in $build)" >&2
 fi
 
+scripts/doc_images.sh "$build"
+
 python3 scripts/benchmark_tables.py "$out" docs/benchmarks.md "$(nproc)"
 echo "benchmarks: docs/benchmarks.md rewritten from $out" >&2

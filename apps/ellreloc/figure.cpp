@@ -182,7 +182,7 @@ std::string Figure::png() const {
     }
   }
   std::vector<uchar> bytes;
-  if (!cv::imencode(".png", img, bytes)) throw Error("could not encode a PNG figure");
+  if (!cv::imencode(".png", img, bytes, {cv::IMWRITE_PNG_COMPRESSION, 9})) throw Error("could not encode a PNG figure");
   return std::string(bytes.begin(), bytes.end());
 }
 

@@ -95,7 +95,8 @@ void writeOverlay(const std::string& path, const Intrinsics& K, const ObjectMap&
                                      : "green: detections  orange: map at the pose  magenta: matches";
   label(img, legend, cv::Point(8, K.height - 8), cv::Scalar(60, 60, 60), 0.4);
   std::vector<uchar> png;
-  if (!cv::imencode(".png", img, png)) throw Error(path + ": could not encode the overlay as PNG");
+  if (!cv::imencode(".png", img, png, {cv::IMWRITE_PNG_COMPRESSION, 6}))
+    throw Error(path + ": could not encode the overlay as PNG");
   writeFileAtomically(path, std::string(png.begin(), png.end()));
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 /// \file box.hpp
-/// Axis-aligned image boxes [x1, y1, x2, y2] in pixels (FORMATS.md: pixel (0,0) is the
+/// Axis-aligned image boxes [x1, y1, x2, y2] in pixels (docs/formats.md: pixel (0,0) is the
 /// centre of the top-left pixel).
 
 #include <Eigen/Core>

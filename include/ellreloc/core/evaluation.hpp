@@ -1,6 +1,6 @@
 #pragma once
 /// \file evaluation.hpp
-/// The relocalization metrics of FORMATS.md and the paper's Table I, shared by the command
+/// The relocalization metrics of docs/formats.md and the paper's Table I, shared by the command
 /// line, the benchmarks and the tests: the position and rotation error of a pose, the validity
 /// rule (within 30 cm and 30 degrees), and a table row over every query frame.
 
@@ -12,7 +12,7 @@
 
 namespace ellreloc {
 
-/// A relocalized pose is valid within these bounds of the truth (FORMATS.md).
+/// A relocalized pose is valid within these bounds of the truth (docs/formats.md).
 constexpr double kValidPositionCm = 30.0;
 constexpr double kValidRotationDeg = 30.0;
 

@@ -71,7 +71,7 @@ struct ScoredPose {
   double cost = 0.0;
 };
 
-/// Rotation angle of R_a^T R_b in degrees (the rotation error of FORMATS.md).
+/// Rotation angle of R_a^T R_b in degrees (the rotation error of docs/formats.md).
 /// Computed through a quaternion (2 atan2), which stays accurate for tiny angles where
 /// acos((trace - 1) / 2) does not.
 inline double rotationErrorDeg(const Eigen::Matrix3d& Ra, const Eigen::Matrix3d& Rb) {

@@ -1,6 +1,6 @@
 #pragma once
 /// \file detections.hpp
-/// Detection files (FORMATS.md): a JSON array of frames, each with a file name and its
+/// Detection files (docs/formats.md): a JSON array of frames, each with a file name and its
 /// detections (`bbox` required; optional `mask` as COCO RLE, `polygon`, `ellipse`,
 /// `object_id`), and optional per-frame `keypoints` matched to the map's points.
 

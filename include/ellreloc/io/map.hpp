@@ -1,6 +1,6 @@
 #pragma once
 /// \file map.hpp
-/// Object maps: the JSON map of FORMATS.md (objects as centre/axes/rotation or as a dual
+/// Object maps: the JSON map of docs/formats.md (objects as centre/axes/rotation or as a dual
 /// quadric) and OA-SLAM's text maps (`track_id category_id` + 16 column-major Q* entries).
 
 #include <string>
