@@ -698,4 +698,6 @@ def write_detections(path: str | os.PathLike[str], frames: list[DetectionFrame])
 
 def write_map(path: str | os.PathLike[str], map: ObjectMap) -> None: """Writes the JSON map atomically."""
 
+def write_overlay(path: str | os.PathLike[str], camera: Intrinsics, map: ObjectMap, observations: list[Observation], pose: Optional[Pose] = ..., truth: Optional[Pose] = ..., matches: Sequence[EllipseMatch | tuple[Ellipse, Ellipsoid]] = ..., text: list[str] = ..., background: Any = ...) -> None: """A PNG picture of one relocalization (what `ellreloc relocalize --overlays` draws): observations in green, the map projected with `pose` in orange, `matches` ((observation, object index) pairs, e.g. [(m.observation, m.object) for m in result.matches]) in magenta, the map at `truth` in blue, `text` at the top left, over the `background` image or a blank canvas."""
+
 def write_trajectory(path: str | os.PathLike[str], poses: Sequence[StampedPose | tuple[float | str, Pose]]) -> None: """Writes StampedPose or (timestamp, Pose) items as a TUM trajectory, atomically; a str timestamp is written as given."""

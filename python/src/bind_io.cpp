@@ -9,6 +9,7 @@
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/map.hpp"
+#include "ellreloc/io/overlay.hpp"
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
 
@@ -116,6 +117,23 @@ void bindFiles(py::module_& m) {
       },
       py::arg("path"), py::arg("units_per_metre") = io::kTumDepthUnitsPerMetre,
       "A 16-bit depth PNG as a (height, width) float32 array in metres (0 = no reading).");
+  m.def(
+      "write_overlay",
+      [](const py::handle& path, const Intrinsics& K, const ObjectMap& map, std::vector<Observation> observations,
+         const std::optional<Pose>& pose, const std::optional<Pose>& truth, std::vector<std::pair<int, int>> matches,
+         std::vector<std::string> text, const py::handle& background) {
+        io::OverlayContent c{std::move(observations), pose, truth, std::move(matches), std::move(text)};
+        const std::string out = pathFrom(path), image = background.is_none() ? "" : pathFrom(background);
+        py::gil_scoped_release release;
+        io::writeOverlay(out, K, map, c, image);
+      },
+      py::arg("path"), py::arg("camera"), py::arg("map"), py::arg("observations"), py::arg("pose") = py::none(),
+      py::arg("truth") = py::none(), py::arg("matches") = std::vector<std::pair<int, int>>{},
+      py::arg("text") = std::vector<std::string>{}, py::arg("background") = py::none(),
+      "A PNG picture of one relocalization (what `ellreloc relocalize --overlays` draws): observations in green, "
+      "the map projected with `pose` in orange, `matches` ((observation, object index) pairs, e.g. "
+      "[(m.observation, m.object) for m in result.matches]) in magenta, the map at `truth` in blue, `text` at "
+      "the top left, over the `background` image or a blank canvas.");
   py::class_<io::Association>(m, "Association", "A line of a TUM association file.")
       .def_readonly("rgb_time", &io::Association::rgb_time)
       .def_readonly("rgb_path", &io::Association::rgb_path)

@@ -168,3 +168,19 @@ def test_options_and_bad_input_are_refused_clearly(fr2):
         relocalizer.relocalize(frames[0], keypoints=np.zeros((4, 2)))
     empty = relocalizer.relocalize([])
     assert empty.status == E.RelocalizationStatus.not_enough_observations and empty.pose is None and empty.T_wc is None
+
+
+def test_overlays_from_python(office, tmp_path):
+    scene, camera, map_ = office
+    truth = E.sim.query_trajectory(scene, 2, seed=8)[0]
+    observations, _ = E.sim.observe_map(map_, camera, truth)
+    result = E.ObjectRelocalizer(map_, camera).relocalize(observations)
+    E.write_overlay(tmp_path / "a.png", camera, map_, observations, result.pose, truth,
+                    [(m.observation, m.object) for m in result.matches], ["frame 0", result.status.name])
+    data = (tmp_path / "a.png").read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    assert (width, height) == (camera.width, camera.height)
+    with pytest.raises(OSError, match="missing.png: cannot open"):
+        E.write_overlay(tmp_path / "b.png", camera, map_, observations, background=tmp_path / "missing.png")
+    assert not (tmp_path / "b.png").exists()
