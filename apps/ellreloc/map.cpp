@@ -38,13 +38,13 @@ std::vector<PosedDetections> posedFrames(const std::vector<DetectionFrame>& fram
   return out;
 }
 
-/// Printed even when quiet: it is a result.
 std::string joined(const std::vector<std::string>& items) {
   std::string out;
   for (const std::string& item : items) out += (out.empty() ? "" : ", ") + item;
   return out;
 }
 
+/// Printed even when quiet: it is a result.
 void printQuality(const MapQuality& q) {
   std::printf(
       "map quality on %zu held-out frames: median best same-category IoU %.3f (mean %.3f) over %zu boxes, "

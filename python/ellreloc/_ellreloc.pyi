@@ -597,6 +597,7 @@ class SearchOptions:
     budget: SearchBudget
     max_overlap_evaluations: int
     max_candidate_pairs: int
+    threads: int
 
 
 class StampedPose:

@@ -174,7 +174,8 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("check_sample_overlap", &SearchOptions::check_sample_overlap)
       .def_readwrite("budget", &SearchOptions::budget)
       .def_readwrite("max_overlap_evaluations", &SearchOptions::max_overlap_evaluations)
-      .def_readwrite("max_candidate_pairs", &SearchOptions::max_candidate_pairs);
+      .def_readwrite("max_candidate_pairs", &SearchOptions::max_candidate_pairs)
+      .def_readwrite("threads", &SearchOptions::threads, "threads splitting one frame's hypotheses (same result)");
   py::class_<ScoringOptions>(m, "ScoringOptions")
       .def(py::init<>())
       .def_readwrite("overlap", &ScoringOptions::overlap)

@@ -167,7 +167,19 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   HypothesisPool pool(options_.refinement.top_k);
   SearchOutcome search;
   const FrameBudget budget = frameBudget(options_.search, map_.objects.size(), usable, start);
-  if (usable >= 3) searchTriplets(estimator, options_, budget, &pool, &search);
+  if (usable >= 3) {
+    // Each further thread scores with its own scorer (scratch buffers) through its own estimator.
+    const size_t threads = static_cast<size_t>(options_.search.threads);
+    std::vector<PoseScorer> scorers(threads - 1, scorer);
+    std::vector<HypothesisEstimator> helpers;
+    helpers.reserve(scorers.size());
+    std::vector<const HypothesisEstimator*> estimators = {&estimator};
+    for (PoseScorer& s : scorers) {
+      helpers.emplace_back(observations, candidates, map_, K_, options_, gate, s);
+      estimators.push_back(&helpers.back());
+    }
+    searchTriplets(estimators, options_, budget, &pool, &search);
+  }
   if (few && (usable <= options_.few_objects.max_observations || search.best_inliers < 3))
     searchFewObjects(estimator, candidates, options_, gravity, budget, &pool, &search);
   result.hypotheses = search.hypotheses;

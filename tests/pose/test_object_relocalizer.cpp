@@ -282,6 +282,36 @@ TEST(ObjectRelocalizer, DeterministicAndThreadSafe) {
   }
 }
 
+// search.threads splits one frame's triplet hypotheses over threads: the same result, to the
+// bit, as one thread (ours with PROSAC and enumeration, and the exhaustive preset).
+TEST(ObjectRelocalizer, OneFrameOnThreadsGivesTheSerialResultThreadSafe) {
+  std::mt19937 rng(86);
+  const Intrinsics K = test::testIntrinsics();
+  for (int preset = 0; preset < 2; ++preset)
+    for (int objects : {8, 30}) {
+      const Synthetic s = makeScene(rng, objects, 3, 1.0);
+      if (s.observations.size() < 4) continue;
+      RelocalizerOptions options = preset ? RelocalizerOptions::oaSlam() : RelocalizerOptions();
+      const RelocalizationResult serial = ObjectRelocalizer(s.map, K, options).relocalize(s.observations);
+      for (int threads : {2, 3}) {
+        options.search.threads = threads;
+        const RelocalizationResult split = ObjectRelocalizer(s.map, K, options).relocalize(s.observations);
+        SCOPED_TRACE(std::to_string(objects) + " objects, preset " + std::to_string(preset) + ", " +
+                     std::to_string(threads) + " threads");
+        EXPECT_EQ(split.status, serial.status);
+        EXPECT_EQ(split.pose.rotation(), serial.pose.rotation());
+        EXPECT_EQ(split.pose.translation(), serial.pose.translation());
+        EXPECT_EQ(split.hypotheses, serial.hypotheses);
+        EXPECT_EQ(split.iterations, serial.iterations);
+        EXPECT_EQ(split.inliers.size(), serial.inliers.size());
+        EXPECT_EQ(split.cost, serial.cost);
+      }
+    }
+  RelocalizerOptions bad;
+  bad.search.threads = 0;
+  EXPECT_EQ(ObjectRelocalizer(ObjectMap{}, K, bad).relocalize({}).status, RelocalizationStatus::InvalidInput);
+}
+
 TEST(ObjectRelocalizer, OaSlamPresetAlsoWorksOnBoxes) {
   std::mt19937 rng(85);
   const Intrinsics K = test::testIntrinsics();

@@ -207,3 +207,87 @@ TEST(Ransac, AdaptiveIterationCount) {
   EXPECT_EQ(adaptiveIterations(1.0, 3, 0.99), 0);
   EXPECT_EQ(adaptiveIterations(0.0, 3, 0.99), std::numeric_limits<int>::max());
 }
+
+namespace {
+
+/// The serial RANSAC loop written out plainly, as the reference for ransacOnThreads.
+template <typename Sampler>
+RansacStats referenceRansac(const PnPEstimator& est, Sampler& sampler, const RansacOptions& o, Pose* best,
+                            std::vector<double>* seen) {
+  RansacStats st;
+  int needed = o.max_iterations;
+  int sample[3];
+  Pose models[4];
+  while (true) {
+    if (st.iterations >= o.max_iterations || st.hypotheses >= o.max_hypotheses) {
+      st.budget_exhausted = true;
+      break;
+    }
+    if (st.iterations >= std::max(o.min_iterations, needed)) break;
+    if (!sampler.next(sample)) {
+      st.sampler_exhausted = true;
+      break;
+    }
+    ++st.iterations;
+    const int m = est.generate(sample, models);
+    for (int i = 0; i < m; ++i) {
+      ++st.hypotheses;
+      int inliers = 0;
+      const double score = est.score(models[i], &inliers);
+      seen->push_back(score);
+      if (score < st.score) {
+        st.score = score, st.num_inliers = inliers, st.best_iteration = st.iterations, *best = models[i];
+        needed = adaptiveIterations(static_cast<double>(inliers) / est.numData(), 3, o.success_probability);
+      }
+    }
+  }
+  return st;
+}
+
+}  // namespace
+
+// Batches scored on threads, taken in sample order: the serial loop's result, statistics and
+// observer calls, for every sampler and for budgets that stop in the middle of a batch.
+TEST(Ransac, OnThreadsIsTheSerialLoopThreadSafe) {
+  const PnPProblem p = makeProblem(40, 0.6, 1e-3, 11);
+  const PnPEstimator est{&p};
+  RansacOptions budgets[3];
+  budgets[1].max_hypotheses = 37;
+  budgets[2].min_iterations = 300, budgets[2].max_iterations = 301;
+  for (const RansacOptions& o : budgets)
+    for (int kind = 0; kind < 3; ++kind) {
+      Pose expected;
+      std::vector<double> expected_seen;
+      UniformSampler u(40, 3, 5);
+      ExhaustiveSampler e(40, 3);
+      ProsacSampler pr(40, 3, 5, 1000);
+      const RansacStats ref = kind == 0   ? referenceRansac(est, u, o, &expected, &expected_seen)
+                              : kind == 1 ? referenceRansac(est, e, o, &expected, &expected_seen)
+                                          : referenceRansac(est, pr, o, &expected, &expected_seen);
+      for (int threads = 1; threads <= 3; ++threads) {
+        const std::vector<PnPEstimator> copies(static_cast<size_t>(threads), est);
+        std::vector<const PnPEstimator*> estimators;
+        for (const PnPEstimator& c : copies) estimators.push_back(&c);
+        Pose best;
+        RansacStats st;
+        std::vector<double> seen;
+        const auto observer = [&](const Pose&, double score, int) { seen.push_back(score); };
+        UniformSampler u2(40, 3, 5);
+        ExhaustiveSampler e2(40, 3);
+        ProsacSampler pr2(40, 3, 5, 1000);
+        if (kind == 0) ransacOnThreads(estimators, u2, o, &best, &st, observer);
+        if (kind == 1) ransacOnThreads(estimators, e2, o, &best, &st, observer);
+        if (kind == 2) ransacOnThreads(estimators, pr2, o, &best, &st, observer);
+        SCOPED_TRACE("sampler " + std::to_string(kind) + ", threads " + std::to_string(threads));
+        EXPECT_EQ(st.iterations, ref.iterations);
+        EXPECT_EQ(st.hypotheses, ref.hypotheses);
+        EXPECT_EQ(st.best_iteration, ref.best_iteration);
+        EXPECT_EQ(st.num_inliers, ref.num_inliers);
+        EXPECT_EQ(st.score, ref.score);
+        EXPECT_EQ(st.budget_exhausted, ref.budget_exhausted);
+        EXPECT_EQ(st.sampler_exhausted, ref.sampler_exhausted);
+        EXPECT_EQ(seen, expected_seen);
+        EXPECT_EQ(best.translation(), expected.translation());
+      }
+    }
+}

@@ -16,12 +16,17 @@
 /// A sample the estimator cannot use (e.g. repeated observations) simply generates 0 models.
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <limits>
+#include <mutex>
 #include <numeric>
+#include <optional>
 #include <random>
+#include <thread>
 #include <vector>
 
 namespace ellreloc {
@@ -162,48 +167,144 @@ struct IgnoreScoredModels {
   void operator()(const Model&, double /*score*/, int /*num_inliers*/) const {}
 };
 
-/// Runs RANSAC. `best` receives the best model; returns false when no model was generated.
-/// `observer(model, score, num_inliers)` is called for every scored model, in order.
+namespace detail {
+
+/// Runs a function on `threads` threads (the calling one among them) once per call of run(),
+/// and waits for all of them: a small pool for one RANSAC call's batches.
+class BatchWorkers {
+ public:
+  template <typename Work>
+  BatchWorkers(int threads, Work work) {
+    for (int t = 1; t < threads; ++t)
+      threads_.emplace_back([this, t, work] {
+        int seen = 0;
+        while (true) {
+          std::unique_lock<std::mutex> lock(mutex_);
+          wake_.wait(lock, [&] { return quit_ || generation_ != seen; });
+          if (quit_) return;
+          seen = generation_;
+          lock.unlock();
+          work(t);
+          lock.lock();
+          if (++finished_ == static_cast<int>(threads_.size())) done_.notify_one();
+        }
+      });
+  }
+  ~BatchWorkers() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      quit_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+  /// work(0) here and work(t) on each other thread; returns when all have returned.
+  template <typename Work>
+  void run(Work work) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      finished_ = 0;
+      ++generation_;
+    }
+    wake_.notify_all();
+    work(0);
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [&] { return finished_ == static_cast<int>(threads_.size()); });
+  }
+
+ private:
+  std::vector<std::thread> threads_;
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  int generation_ = 0, finished_ = 0;
+  bool quit_ = false;
+};
+
+}  // namespace detail
+
+/// Runs RANSAC with one estimator per thread: samples are drawn in order in batches whose
+/// models are generated and scored on `estimators.size()` threads (estimators[t] only on thread
+/// t, so each may keep scratch state; they must give the same models and scores for a sample),
+/// then taken in sample order under the serial stopping rules. The result, the statistics and
+/// the observer's calls are therefore those of one estimator on one thread (unless the time
+/// budget stops it); only samples drawn past the stopping point are wasted work.
+/// `best` receives the best model; returns false when no model was generated.
 template <typename Estimator, typename Sampler, typename Observer = IgnoreScoredModels>
-bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& options, typename Estimator::Model* best,
-            RansacStats* stats, Observer&& observer = Observer{}) {
+bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& sampler, const RansacOptions& options,
+                     typename Estimator::Model* best, RansacStats* stats, Observer&& observer = Observer{}) {
   using Clock = std::chrono::steady_clock;
+  using Model = typename Estimator::Model;
+  struct Slot {
+    int sample[Estimator::kSampleSize];
+    Model models[Estimator::kMaxModels];
+    double scores[Estimator::kMaxModels];
+    int inliers[Estimator::kMaxModels];
+    int count = 0;
+  };
   const auto start = Clock::now();
+  const int threads = std::max(1, static_cast<int>(estimators.size()));
+  // One sample at a time on one thread: nothing is generated past the stopping point.
+  const int batch_capacity = threads == 1 ? 1 : 8 * threads;
+  std::vector<Slot> batch(static_cast<size_t>(batch_capacity));
+  int filled = 0, cursor = 0;
+  std::atomic<int> next_slot{0};
+  const auto work = [&](int t) {
+    const Estimator& estimator = *estimators[static_cast<size_t>(t)];
+    for (int i = next_slot++; i < filled; i = next_slot++) {
+      Slot& s = batch[static_cast<size_t>(i)];
+      s.count = estimator.generate(s.sample, s.models);
+      for (int m = 0; m < s.count; ++m) s.scores[m] = estimator.score(s.models[m], &s.inliers[m]);
+    }
+  };
+  std::optional<detail::BatchWorkers> workers;
+  if (threads > 1) workers.emplace(threads, work);
   RansacStats st;
-  int sample[Estimator::kSampleSize];
-  typename Estimator::Model models[Estimator::kMaxModels];
-  const size_t n = estimator.numData();
+  const size_t n = estimators.front()->numData();
   int needed = options.max_iterations;
-  bool have = false;
+  bool have = false, sampler_done = false;
   while (true) {
     if (st.iterations >= options.max_iterations || st.hypotheses >= options.max_hypotheses) {
       st.budget_exhausted = true;
       break;
     }
-    if (st.iterations >= std::max(options.min_iterations, needed)) break;
+    const int stop_at = std::max(options.min_iterations, needed);
+    if (st.iterations >= stop_at) break;
     if (options.max_time_ms > 0.0 && (st.iterations & 7) == 0 &&
         std::chrono::duration<double, std::milli>(Clock::now() - start).count() > options.max_time_ms) {
       st.budget_exhausted = true;
       break;
     }
-    if (!sampler.next(sample)) {
-      st.sampler_exhausted = true;
-      break;
+    if (cursor == filled) {  // the next batch: as many samples as the loop may still take
+      const long room = std::min<long>({options.max_iterations - st.iterations, stop_at - st.iterations,
+                                        options.max_hypotheses - st.hypotheses, batch_capacity});
+      filled = cursor = 0;
+      while (!sampler_done && filled < room)
+        if (sampler.next(batch[static_cast<size_t>(filled)].sample))
+          ++filled;
+        else
+          sampler_done = true;
+      if (filled == 0) {
+        st.sampler_exhausted = true;
+        break;
+      }
+      next_slot = 0;
+      if (workers)
+        workers->run(work);
+      else
+        work(0);
     }
+    const Slot& s = batch[static_cast<size_t>(cursor++)];
     ++st.iterations;
-    const int m = estimator.generate(sample, models);
-    for (int i = 0; i < m; ++i) {
+    for (int i = 0; i < s.count; ++i) {
       ++st.hypotheses;
-      int inliers = 0;
-      const double score = estimator.score(models[i], &inliers);
-      observer(models[i], score, inliers);
-      if (score < st.score) {
-        st.score = score;
-        st.num_inliers = inliers;
+      observer(s.models[i], s.scores[i], s.inliers[i]);
+      if (s.scores[i] < st.score) {
+        st.score = s.scores[i];
+        st.num_inliers = s.inliers[i];
         st.best_iteration = st.iterations;
-        *best = models[i];
+        *best = s.models[i];
         have = true;
-        needed = adaptiveIterations(n ? static_cast<double>(inliers) / n : 0.0, Estimator::kSampleSize,
+        needed = adaptiveIterations(n ? static_cast<double>(s.inliers[i]) / n : 0.0, Estimator::kSampleSize,
                                     options.success_probability);
       }
     }
@@ -211,6 +312,15 @@ bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& o
   st.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   if (stats) *stats = st;
   return have;
+}
+
+/// Runs RANSAC on one thread. `best` receives the best model; returns false when no model was
+/// generated. `observer(model, score, num_inliers)` is called for every scored model, in order.
+template <typename Estimator, typename Sampler, typename Observer = IgnoreScoredModels>
+bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& options, typename Estimator::Model* best,
+            RansacStats* stats, Observer&& observer = Observer{}) {
+  return ransacOnThreads(std::vector<const Estimator*>{&estimator}, sampler, options, best, stats,
+                         std::forward<Observer>(observer));
 }
 
 }  // namespace ellreloc

@@ -51,6 +51,10 @@ struct SearchOptions {
   /// bounded (about 100 bytes a pair) whatever the frame and map: beyond it the least confident
   /// observations are left out (RelocalizationResult::skipped says so).
   long max_candidate_pairs = 1000000;
+  /// Threads that generate and score one frame's triplet hypotheses (core/ransac.hpp,
+  /// ransacOnThreads): the same result whatever the count. For a host that relocalizes one frame
+  /// at a time; many frames at once gain more from a thread per frame.
+  int threads = 1;
 
   SearchOptions() {
     budget.min_iterations = 50;
@@ -172,6 +176,7 @@ struct RelocalizerOptions {
       return "search.budget.success_probability is not in (0, 1)";
     if (search.max_overlap_evaluations < 0) return "search.max_overlap_evaluations is negative";
     if (search.max_candidate_pairs < 1) return "search.max_candidate_pairs is below 1";
+    if (search.threads < 1 || search.threads > 256) return "search.threads is not in [1, 256]";
     if (!(scoring.min_overlap >= 0 && scoring.min_overlap <= 1)) return "scoring.min_overlap is not in [0, 1]";
     if (!(finite(scoring.unmatched_cost) && scoring.unmatched_cost >= 0))
       return "scoring.unmatched_cost is negative or not finite";

@@ -19,9 +19,9 @@ FrameBudget frameBudget(const SearchOptions& search, size_t num_objects, int num
   return budget;
 }
 
-void searchTriplets(const HypothesisEstimator& estimator, const RelocalizerOptions& options, const FrameBudget& frame,
-                    HypothesisPool* pool, SearchOutcome* outcome) {
-  const int n = static_cast<int>(estimator.numData());
+void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, const RelocalizerOptions& options,
+                    const FrameBudget& frame, HypothesisPool* pool, SearchOutcome* outcome) {
+  const int n = static_cast<int>(estimators.front()->numData());
   HypothesisSampler sampler = options.search.sampler;
   if (sampler == HypothesisSampler::Auto) {
     const double triplets = static_cast<double>(n) * (n - 1) * (n - 2) / 6.0;
@@ -46,12 +46,12 @@ void searchTriplets(const HypothesisEstimator& estimator, const RelocalizerOptio
     case HypothesisSampler::Auto:  // resolved above
     case HypothesisSampler::Exhaustive: {
       ExhaustiveSampler s(n, 3);
-      found = ransac(estimator, s, budget, &best, &stats, remember);
+      found = ransacOnThreads(estimators, s, budget, &best, &stats, remember);
       break;
     }
     case HypothesisSampler::Uniform: {
       UniformSampler s(n, 3, budget.seed);
-      found = ransac(estimator, s, budget, &best, &stats, remember);
+      found = ransacOnThreads(estimators, s, budget, &best, &stats, remember);
       break;
     }
     case HypothesisSampler::Prosac: {
@@ -59,7 +59,7 @@ void searchTriplets(const HypothesisEstimator& estimator, const RelocalizerOptio
       // assumes samples from all the data, and a wrong early model must not end the search
       // while good pairs of lower quality are still out of reach.
       ProsacSampler s(n, 3, budget.seed, 1000);
-      found = ransac(estimator, s, budget, &best, &stats, remember);
+      found = ransacOnThreads(estimators, s, budget, &best, &stats, remember);
       break;
     }
   }
