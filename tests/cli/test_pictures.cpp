@@ -211,10 +211,10 @@ TEST_F(Pictures, TheReportRendersInABrowserWithEveryFrame) {
   if (chromium.empty()) GTEST_SKIP() << "no chromium to render the report (scripts/install-deps.sh installs it)";
   // The page's script counts the rows of the frame table once it has run without error.
   const std::string dom = dir.path("dom.html"), log = dir.path("browser.log");
-  const std::string cmd = chromium + " --headless --no-sandbox --disable-gpu --disable-dev-shm-usage " +
-                          "--user-data-dir=" + dir.path("profile") +
-                          " --enable-logging=stderr --v=0 --dump-dom file://" + dir.path("report.html") + " >" + dom +
-                          " 2>" + log;
+  const std::string cmd =
+      "timeout 120 " + chromium + " --headless --no-sandbox --disable-gpu --disable-dev-shm-usage " +
+      "--user-data-dir=" + dir.path("profile") + " --enable-logging=stderr --v=0 --dump-dom file://" +
+      dir.path("report.html") + " >" + dom + " 2>" + log;
   ASSERT_EQ(std::system(cmd.c_str()), 0) << readFile(log);
   const std::string rendered = readFile(dom);
   EXPECT_NE(rendered.find("data-frames=\"8\""), std::string::npos) << rendered.substr(0, 400) << "\n" << readFile(log);

@@ -170,7 +170,9 @@ struct IgnoreScoredModels {
 namespace detail {
 
 /// Runs a function on `threads` threads (the calling one among them) once per call of run(),
-/// and waits for all of them: a small pool for one RANSAC call's batches.
+/// and waits for all of them: a small pool for one RANSAC call's batches. A batch takes tens of
+/// microseconds, about what waking a sleeping thread costs, so the threads spin briefly on an
+/// atomic counter before they sleep, and the caller spins until they are done.
 class BatchWorkers {
  public:
   template <typename Work>
@@ -179,14 +181,18 @@ class BatchWorkers {
       threads_.emplace_back([this, t, work] {
         int seen = 0;
         while (true) {
-          std::unique_lock<std::mutex> lock(mutex_);
-          wake_.wait(lock, [&] { return quit_ || generation_ != seen; });
-          if (quit_) return;
-          seen = generation_;
-          lock.unlock();
+          for (int spins = 0; generation_.load(std::memory_order_acquire) == seen && !quit_.load(); ++spins) {
+            if (spins < kSpins) {
+              std::this_thread::yield();
+              continue;
+            }
+            std::unique_lock<std::mutex> lock(mutex_);
+            wake_.wait(lock, [&] { return quit_.load() || generation_.load() != seen; });
+          }
+          if (quit_.load()) return;
+          seen = generation_.load(std::memory_order_acquire);
           work(t);
-          lock.lock();
-          if (++finished_ == static_cast<int>(threads_.size())) done_.notify_one();
+          finished_.fetch_add(1, std::memory_order_acq_rel);
         }
       });
   }
@@ -201,23 +207,23 @@ class BatchWorkers {
   /// work(0) here and work(t) on each other thread; returns when all have returned.
   template <typename Work>
   void run(Work work) {
+    finished_.store(0, std::memory_order_relaxed);
     {
       const std::lock_guard<std::mutex> lock(mutex_);
-      finished_ = 0;
-      ++generation_;
+      generation_.fetch_add(1, std::memory_order_release);
     }
     wake_.notify_all();
     work(0);
-    std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [&] { return finished_ == static_cast<int>(threads_.size()); });
+    while (finished_.load(std::memory_order_acquire) < static_cast<int>(threads_.size())) std::this_thread::yield();
   }
 
  private:
+  static constexpr int kSpins = 2000;  // yields before sleeping: a few hundred microseconds
   std::vector<std::thread> threads_;
   std::mutex mutex_;
-  std::condition_variable wake_, done_;
-  int generation_ = 0, finished_ = 0;
-  bool quit_ = false;
+  std::condition_variable wake_;
+  std::atomic<int> generation_{0}, finished_{0};
+  std::atomic<bool> quit_{false};
 };
 
 }  // namespace detail
