@@ -163,8 +163,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
   const PoseGate gate{gravity ? &*gravity : nullptr, options_.gravity.gate_deg,
                       options_.envelope ? &*options_.envelope : nullptr};
-  const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer);
   HypothesisPool pool(options_.refinement.top_k);
+  const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;
   const FrameBudget budget = frameBudget(options_.search, map_.objects.size(), usable, start);
   if (usable >= 3) {
@@ -175,7 +175,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     helpers.reserve(scorers.size());
     std::vector<const HypothesisEstimator*> estimators = {&estimator};
     for (PoseScorer& s : scorers) {
-      helpers.emplace_back(observations, candidates, map_, K_, options_, gate, s);
+      helpers.emplace_back(observations, candidates, map_, K_, options_, gate, s, &pool);
       estimators.push_back(&helpers.back());
     }
     searchTriplets(estimators, options_, budget, &pool, &search);

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "ellreloc/core/p3p.hpp"
 #include "ellreloc/core/projection.hpp"
@@ -85,7 +86,8 @@ bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
 
 double HypothesisEstimator::score(const Model& model, int* num_inliers) const {
   thread_local std::vector<ObjectCorrespondence> matches;
-  const double cost = scorer_.cost(model.pose, kRankingIoUVertices, &matches, &model.own);
+  const double give_up_at = pool_ ? pool_->admissionCost() : std::numeric_limits<double>::infinity();
+  const double cost = scorer_.cost(model.pose, kRankingIoUVertices, &matches, &model.own, give_up_at);
   *num_inliers = static_cast<int>(matches.size());
   return cost;
 }

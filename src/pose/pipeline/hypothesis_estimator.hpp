@@ -11,6 +11,7 @@
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
+#include "hypothesis_pool.hpp"
 #include "pose_scorer.hpp"
 
 namespace ellreloc::pipeline {
@@ -39,15 +40,19 @@ class HypothesisEstimator {
   static constexpr int kSampleSize = 3;
   static constexpr int kMaxModels = 4;
 
+  /// With a `pool`, score() gives up on a pose as soon as bounds show that it could not enter
+  /// the pool (infinite cost): such a pose changes nothing, so the search's result is the same.
   HypothesisEstimator(const std::vector<Observation>& observations, const Candidates& candidates, const ObjectMap& map,
-                      const Intrinsics& K, const RelocalizerOptions& options, const PoseGate& gate, PoseScorer& scorer)
+                      const Intrinsics& K, const RelocalizerOptions& options, const PoseGate& gate, PoseScorer& scorer,
+                      const HypothesisPool* pool = nullptr)
       : observations_(observations),
         pairs_(candidates.pairs),
         map_(map),
         K_(K),
         options_(options),
         gate_(gate),
-        scorer_(scorer) {}
+        scorer_(scorer),
+        pool_(pool) {}
 
   // The RANSAC estimator concept (core/ransac.hpp) over candidate pairs.
   size_t numData() const { return pairs_.size(); }
@@ -76,6 +81,7 @@ class HypothesisEstimator {
   const RelocalizerOptions& options_;
   PoseGate gate_;
   PoseScorer& scorer_;
+  const HypothesisPool* pool_;
 };
 
 }  // namespace ellreloc::pipeline

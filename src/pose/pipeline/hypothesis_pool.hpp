@@ -2,6 +2,8 @@
 // The best few distinct hypotheses of a search, for the refinement stage.
 
 #include <algorithm>
+#include <atomic>
+#include <limits>
 #include <vector>
 
 #include "ellreloc/core/pose.hpp"
@@ -30,6 +32,10 @@ class HypothesisPool {
     if (entries_.size() > capacity_) entries_.pop_back();
   }
 
+  /// The cost a pose must stay below to change the pool (infinite until it is full). Read by
+  /// scorers on other threads: it only decreases, so a stale value is a safe one.
+  double admissionCost() const { return admission_.load(std::memory_order_relaxed); }
+
   bool empty() const { return entries_.empty(); }
   const ScoredPose& best() const { return entries_.front(); }
   /// Ascending cost.
@@ -39,9 +45,11 @@ class HypothesisPool {
   void sortByCost() {
     std::sort(entries_.begin(), entries_.end(),
               [](const ScoredPose& x, const ScoredPose& y) { return x.cost < y.cost; });
+    if (entries_.size() >= capacity_) admission_.store(entries_[capacity_ - 1].cost, std::memory_order_relaxed);
   }
   size_t capacity_;
   std::vector<ScoredPose> entries_;
+  std::atomic<double> admission_{std::numeric_limits<double>::infinity()};
 };
 
 }  // namespace ellreloc::pipeline

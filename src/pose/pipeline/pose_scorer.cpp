@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
@@ -77,8 +78,32 @@ double PoseScorer::overlapReaching(const Observation& o, const Ellipse& projecte
   return overlap(o, projected, vertices);
 }
 
+double PoseScorer::costLowerBound(int vertices) const {
+  const double miss = options_.unmatched_cost;
+  double bound = miss * candidates_.num_usable;
+  for (size_t i = 0; i < observations_.size(); ++i) {
+    if (!candidates_.usable[i]) continue;
+    const Observation& o = observations_[i];
+    const std::vector<int>& cands = candidates_.of_observation[i];
+    double gain = 0.0;  // an observation left unmatched gains nothing
+    for (size_t c = 0; c < cands.size(); ++c) {
+      const int j = cands[c];
+      if (!projects_[j]) continue;
+      const Box pb = projected_[j].boundingBox();
+      if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
+      const double ub = options_.overlap == OverlapMeasure::BoxIoU
+                            ? boxIoU(o.box, pb)
+                            : ellipseIoUUpperBound(o.ellipse, projected_[j], vertices);
+      if (ub < options_.min_overlap - 1e-9) continue;
+      gain = std::max(gain, miss - 1.0 + std::min(1.0, ub + 1e-9) * label_weight_[i][c]);
+    }
+    bound -= gain;
+  }
+  return bound;
+}
+
 double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches,
-                        const KnownProjections* known) {
+                        const KnownProjections* known, double give_up_at) {
   const bool valid = K_.isValid() && pose.isValid();  // checked once, not per object
   const Eigen::Matrix<double, 3, 4> P = valid ? projectionMatrix(K_, pose) : Eigen::Matrix<double, 3, 4>::Zero();
   for (int j : relevant_) {
@@ -99,6 +124,11 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     const Projection p = valid ? projectPrepared(e, P, pose) : Projection{};
     projects_[j] = p.ok();
     if (p.ok()) projected_[j] = p.ellipse;
+  }
+  // Most hypotheses are far worse than those kept: bounds show it without an exact overlap.
+  if (give_up_at < std::numeric_limits<double>::infinity() && costLowerBound(vertices) - 1e-9 >= give_up_at) {
+    if (matches) matches->clear();
+    return std::numeric_limits<double>::infinity();
   }
   all_matches_.clear();
   for (size_t i = 0; i < observations_.size(); ++i) {

@@ -2,6 +2,7 @@
 // The one cost of the relocalization pipeline: every stage (sample checks, RANSAC, the few-object
 // poses, refinement, scorePose) ranks poses with it.
 
+#include <limits>
 #include <vector>
 
 #include "candidates.hpp"
@@ -38,9 +39,11 @@ class PoseScorer {
   double overlapReaching(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
 
   /// The cost of a pose: unmatched_cost per usable observation, less (unmatched_cost - (1 -
-  /// credit)) per one-to-one match, greedy on credit. Fills the matches when asked.
+  /// credit)) per one-to-one match, greedy on credit. Fills the matches when asked. When a lower
+  /// bound of the cost (each observation credited with the best overlap bound of its projected
+  /// candidates) already reaches `give_up_at`, returns infinity without the exact overlaps.
   double cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches = nullptr,
-              const KnownProjections* known = nullptr);
+              const KnownProjections* known = nullptr, double give_up_at = std::numeric_limits<double>::infinity());
 
   /// project(map object j, K, pose), with the object's quantities computed once; j must be a
   /// candidate of some observation.
@@ -52,6 +55,9 @@ class PoseScorer {
   const ScoringOptions& options() const { return options_; }
 
  private:
+  /// unmatched_cost per usable observation less, for each, the most its best projected
+  /// candidate could gain by the overlap bound: no exact overlap is computed.
+  double costLowerBound(int vertices) const;
   const std::vector<Observation>& observations_;
   const Candidates& candidates_;
   const ObjectMap& map_;
