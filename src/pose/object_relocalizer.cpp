@@ -167,14 +167,15 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;
   const FrameBudget budget = frameBudget(options_.search, map_.objects.size(), usable, start);
+  // Each further thread scores with its own scorer (scratch buffers), through its own estimator.
+  std::vector<PoseScorer> thread_scorers(static_cast<size_t>(options_.search.threads) - 1, scorer);
+  std::vector<PoseScorer*> scorers = {&scorer};
+  for (PoseScorer& s : thread_scorers) scorers.push_back(&s);
   if (usable >= 3) {
-    // Each further thread scores with its own scorer (scratch buffers) through its own estimator.
-    const size_t threads = static_cast<size_t>(options_.search.threads);
-    std::vector<PoseScorer> scorers(threads - 1, scorer);
     std::vector<HypothesisEstimator> helpers;
-    helpers.reserve(scorers.size());
+    helpers.reserve(thread_scorers.size());
     std::vector<const HypothesisEstimator*> estimators = {&estimator};
-    for (PoseScorer& s : scorers) {
+    for (PoseScorer& s : thread_scorers) {
       helpers.emplace_back(observations, candidates, map_, K_, options_, gate, s, &pool);
       estimators.push_back(&helpers.back());
     }
@@ -192,7 +193,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   // 3. Refinement of the pooled hypotheses, then with the keypoints.
   const RefinementContext context{observations, map_, K_, options_, gravity, gate};
   // Past the time budget only the best hypothesis is refined: the bound is the budget plus one refinement.
-  ChosenPose chosen = refineHypotheses(pool, search.best, scorer, context, budget.timeUp() ? 1 : pool.entries().size());
+  ChosenPose chosen =
+      refineHypotheses(pool, search.best, scorers, context, budget.timeUp() ? 1 : pool.entries().size());
   chosen = refineWithPoints(std::move(chosen), pointMatches(keypoints, map_), scorer, context);
 
   // 4. The result.

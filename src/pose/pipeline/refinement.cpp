@@ -1,5 +1,8 @@
 #include "refinement.hpp"
 
+#include <atomic>
+#include <thread>
+
 namespace ellreloc::pipeline {
 
 namespace {
@@ -44,22 +47,36 @@ std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>
   return out;
 }
 
-ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best, PoseScorer& scorer,
-                            const RefinementContext& context, size_t max_refined) {
+ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
+                            const std::vector<PoseScorer*>& scorers, const RefinementContext& context,
+                            size_t max_refined) {
+  PoseScorer& scorer = *scorers.front();
   ChosenPose best;
   best.pose = search_best;
   best.cost = scorer.cost(search_best, kReportIoUVertices);
-  size_t refined = 0;
+  std::vector<Pose> starts;
   for (const ScoredPose& h : pool.entries()) {
     if (h.cost > pool.best().cost + context.options.refinement.cost_margin) break;  // ascending costs
-    if (refined++ == max_refined) break;
-    ChosenPose candidate = refineRounds(h.pose, scorer, context);
+    if (starts.size() == max_refined) break;
+    starts.push_back(h.pose);
+  }
+  // Each start is refined on its own (on as many threads as there are scorers); the results
+  // are then compared in pool order, so the choice does not depend on the threads.
+  std::vector<ChosenPose> refined(starts.size());
+  std::atomic<size_t> next{0};
+  const auto work = [&](size_t t) {
+    for (size_t i = next++; i < starts.size(); i = next++) refined[i] = refineRounds(starts[i], *scorers[t], context);
+  };
+  std::vector<std::thread> helpers;
+  for (size_t t = 1; t < std::min(scorers.size(), starts.size()); ++t) helpers.emplace_back(work, t);
+  work(0);
+  for (std::thread& h : helpers) h.join();
+  for (const ChosenPose& candidate : refined)
     if (candidate.cost < best.cost || (candidate.refined && candidate.cost <= best.cost)) {
       best.pose = candidate.pose;
       best.cost = candidate.cost;
       best.refined = candidate.refined;
     }
-  }
   best.cost = scorer.cost(best.pose, kReportIoUVertices, &best.matches);
   return best;
 }

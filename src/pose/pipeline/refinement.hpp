@@ -35,9 +35,10 @@ ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementC
 
 /// Starts from `search_best` (the search's best pose) and refines the pooled hypotheses within
 /// refinement.cost_margin of the pool's best, at most `max_refined`, best first; returns the
-/// lowest-cost result.
-ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best, PoseScorer& scorer,
-                            const RefinementContext& context, size_t max_refined);
+/// lowest-cost result. The refinements run on one thread per scorer (the same result).
+ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
+                            const std::vector<PoseScorer*>& scorers, const RefinementContext& context,
+                            size_t max_refined);
 
 /// Refines the chosen pose again with keypoints matched to map points; keeps the result when it
 /// still explains as many observations.
