@@ -27,16 +27,6 @@ ObserveOptions optionsFrom(const std::optional<ObserveOptions>& options, const p
   return o;
 }
 
-/// The box of a mask's pixels in the FORMATS convention (pixel edges: x2 = last column + 1).
-Box maskBox(const RleMask& rle) {
-  int xmin = rle.width, xmax = -1, ymin = rle.height, ymax = -1;
-  forEachRunSegment(rle, [&](int x, int y0, int len) {
-    xmin = std::min(xmin, x), xmax = std::max(xmax, x);
-    ymin = std::min(ymin, y0), ymax = std::max(ymax, y0 + len - 1);
-  });
-  return xmax < 0 ? Box() : Box(xmin, ymin, xmax + 1, ymax + 1);
-}
-
 void bindOptions(py::module_& m) {
   py::enum_<ObservationPolicy>(m, "ObservationPolicy", "Which ellipse a detection gives.")
       .value("paper", ObservationPolicy::Paper, "regular mask -> mask fit, otherwise the box-inscribed ellipse")
@@ -140,7 +130,7 @@ void bindFunctions(py::module_& m) {
         if (!d.mask->isConsistent()) badArgument("mask", "its runs do not add up to height x width");
         d.category_id = category;
         d.score = score;
-        d.bbox = box ? *box : maskBox(*d.mask);
+        d.bbox = box ? *box : maskBox(*d.mask).value_or(Box());
         ObserveOptions o = optionsFrom(options, policy.is_none() ? py::str("mask") : policy);
         return observeDetection(d, d.mask->width, d.mask->height, o);
       },

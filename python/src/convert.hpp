@@ -136,25 +136,10 @@ inline RleMask maskFromArray(const py::handle& h, const std::string& name) {
   if (!((dt.kind() == 'b' || dt.kind() == 'u') && dt.itemsize() == 1) || a.ndim() != 2)
     badArgument(name, "expected a 2-D bool or uint8 numpy array, got " + describe(h));
   if (a.shape(0) <= 0 || a.shape(1) <= 0) badArgument(name, "the mask is empty (" + describe(h) + ")");
-  RleMask rle;
-  rle.height = static_cast<int>(a.shape(0));
-  rle.width = static_cast<int>(a.shape(1));
   const auto* base = static_cast<const char*>(a.data());
   const py::ssize_t sy = a.strides(0), sx = a.strides(1);
-  bool current = false;
-  uint32_t run = 0;
-  for (int x = 0; x < rle.width; ++x)
-    for (int y = 0; y < rle.height; ++y) {
-      const bool on = base[y * sy + x * sx] != 0;
-      if (on != current) {
-        rle.counts.push_back(run);
-        run = 0;
-        current = on;
-      }
-      ++run;
-    }
-  rle.counts.push_back(run);
-  return rle;
+  return encodeRuns(static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)),
+                    [&](int x, int y) { return base[y * sy + x * sx] != 0; });
 }
 
 }  // namespace ellreloc::python

@@ -70,6 +70,7 @@ def test_regular_and_irregular_masks():
     r = E.observation_from_mask(rect, category=62, policy="paper")
     assert r.status == E.ObserveStatus.ok and r.observation.source == E.EllipseSource.mask
     assert r.observation.regular is True and r.observation.category == 62
+    assert r.observation.box.to_array().tolist() == [39.5, 29.5, 109.5, 79.5]  # the outer pixel edges
     np.testing.assert_allclose(r.observation.ellipse.center, [74.5, 54.5], atol=1e-6)  # pixel centres
     np.testing.assert_allclose(r.observation.ellipse.axes, [35.0, 25.0], atol=1e-6)
     # A disc is not regular: the paper's policy falls back to the box; the moments fit the disc.

@@ -182,9 +182,14 @@ TEST(Mask, CropDecodingMatchesFullDecoding) {
       EXPECT_EQ(test::maskOutline(crop), test::maskOutline(full));
       EXPECT_DOUBLE_EQ(crop.x0 - 0.5, det.bbox.x1);
       EXPECT_DOUBLE_EQ(crop.y0 + crop.height - 0.5, det.bbox.y2);
+      // The data's boxes are the masks' outer pixel edges: maskBox gives them from the runs.
+      const Box box = *maskBox(*det.mask);
+      EXPECT_EQ(Eigen::Vector4d(box.x1, box.y1, box.x2, box.y2),
+                Eigen::Vector4d(det.bbox.x1, det.bbox.y1, det.bbox.x2, det.bbox.y2));
     }
   }
   EXPECT_FALSE(decodeMaskCrop(encodeMask(BinaryMask(10, 10))).has_value());  // empty
+  EXPECT_FALSE(maskBox(encodeMask(BinaryMask(10, 10))).has_value());
 }
 
 TEST(Mask, PolygonMaskEqualsPixelCentreRasterisation) {

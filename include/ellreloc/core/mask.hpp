@@ -52,16 +52,38 @@ inline std::optional<BinaryMask> decodeMask(const RleMask& rle) {
   return m;
 }
 
+/// The first and last column and row with a pixel of the mask.
+struct PixelBounds {
+  int xmin = 0, xmax = 0, ymin = 0, ymax = 0;
+};
+
+/// The pixel bounds of a run-length mask (from its runs, no decoding); nullopt when it is
+/// inconsistent or empty.
+inline std::optional<PixelBounds> maskPixelBounds(const RleMask& rle) {
+  if (!rle.isConsistent()) return std::nullopt;
+  PixelBounds b{rle.width, -1, rle.height, -1};
+  forEachRunSegment(rle, [&](int x, int y0, int len) {
+    b.xmin = std::min(b.xmin, x), b.xmax = std::max(b.xmax, x);
+    b.ymin = std::min(b.ymin, y0), b.ymax = std::max(b.ymax, y0 + len - 1);
+  });
+  if (b.xmax < 0) return std::nullopt;
+  return b;
+}
+
+/// The box of a mask's pixels in the convention of docs/formats.md (pixel centres at integers,
+/// so the box runs along the outer pixel edges); nullopt when inconsistent or empty.
+inline std::optional<Box> maskBox(const RleMask& rle) {
+  const std::optional<PixelBounds> b = maskPixelBounds(rle);
+  if (!b) return std::nullopt;
+  return Box(b->xmin - 0.5, b->ymin - 0.5, b->xmax + 0.5, b->ymax + 0.5);
+}
+
 /// Decodes only the bounding box of a run-length mask's pixels, as a crop (BinaryMask::x0, y0):
 /// the work is proportional to the object, not to the image. nullopt when inconsistent or empty.
 inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle) {
-  if (!rle.isConsistent()) return std::nullopt;
-  int xmin = rle.width, xmax = -1, ymin = rle.height, ymax = -1;
-  forEachRunSegment(rle, [&](int x, int y0, int len) {
-    xmin = std::min(xmin, x), xmax = std::max(xmax, x);
-    ymin = std::min(ymin, y0), ymax = std::max(ymax, y0 + len - 1);
-  });
-  if (xmax < 0) return std::nullopt;
+  const std::optional<PixelBounds> bounds = maskPixelBounds(rle);
+  if (!bounds) return std::nullopt;
+  const auto [xmin, xmax, ymin, ymax] = *bounds;
   BinaryMask m(ymax - ymin + 1, xmax - xmin + 1);
   m.x0 = xmin;
   m.y0 = ymin;
@@ -75,25 +97,10 @@ inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle) {
 
 /// Encodes a mask (of the whole image, for a crop) as COCO run lengths.
 inline RleMask encodeMask(const BinaryMask& m) {
-  RleMask rle;
-  rle.height = m.image_height;
-  rle.width = m.image_width;
-  uint8_t current = 0;
-  uint32_t run = 0;
-  for (int x = 0; x < m.image_width; ++x) {
-    for (int y = 0; y < m.image_height; ++y) {
-      const int lx = x - m.x0, ly = y - m.y0;
-      const uint8_t v = m.inside(lx, ly) && m.at(lx, ly) ? 1 : 0;
-      if (v != current) {
-        rle.counts.push_back(run);
-        run = 0;
-        current = v;
-      }
-      ++run;
-    }
-  }
-  rle.counts.push_back(run);
-  return rle;
+  return encodeRuns(m.image_height, m.image_width, [&m](int x, int y) {
+    const int lx = x - m.x0, ly = y - m.y0;
+    return m.inside(lx, ly) && m.at(lx, ly) != 0;
+  });
 }
 
 /// The run-length mask of a polygon (even-odd rule): pixel (x, y) is set when its centre lies

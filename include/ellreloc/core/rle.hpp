@@ -55,6 +55,29 @@ void forEachRunSegment(const RleMask& rle, F f) {
   }
 }
 
+/// The COCO run lengths of a height x width mask whose pixel (x, y) is set when is_set(x, y):
+/// the pixels are visited in column-major order, once each.
+template <typename IsSet>
+RleMask encodeRuns(int height, int width, IsSet is_set) {
+  RleMask rle;
+  rle.height = height;
+  rle.width = width;
+  bool current = false;
+  uint32_t run = 0;
+  for (int x = 0; x < width; ++x)
+    for (int y = 0; y < height; ++y) {
+      const bool on = is_set(x, y);
+      if (on != current) {
+        rle.counts.push_back(run);
+        run = 0;
+        current = on;
+      }
+      ++run;
+    }
+  rle.counts.push_back(run);
+  return rle;
+}
+
 /// Encodes run lengths as pycocotools' compressed string.
 inline std::string encodeRleString(const std::vector<uint32_t>& counts) {
   std::string s;
