@@ -32,20 +32,13 @@ struct RealSet {
   std::vector<std::vector<Observation>> frames;
 };
 
-std::vector<Observation> observeFrame(const DetectionFrame& f, const Intrinsics& K) {
-  std::vector<Observation> out;
-  for (const Detection& d : f.detections)
-    if (const ObserveResult r = observeDetection(d, K.width, K.height); r.observation) out.push_back(*r.observation);
-  return out;
-}
-
 RealSet fr2() {
   RealSet s;
   const std::string d = kData + "/tum_fr2_desk";
   s.K = io::readCamera(d + "/camera.yaml");
   s.map = io::readMap(d + "/map.json");
   for (const DetectionFrame& f : io::readDetections(d + "/keyframes.detections.json"))
-    s.frames.push_back(observeFrame(f, s.K));
+    s.frames.push_back(observeDetections(f.detections, s.K.width, s.K.height));
   return s;
 }
 
@@ -63,7 +56,8 @@ RealSet fr3() {
       mapper.addKeyframe(truth[*k].pose, frames[i].detections);
   mapper.finish();
   s.map = mapper.map();
-  for (size_t i = 1; i < frames.size(); i += 10) s.frames.push_back(observeFrame(frames[i], s.K));
+  for (size_t i = 1; i < frames.size(); i += 10)
+    s.frames.push_back(observeDetections(frames[i].detections, s.K.width, s.K.height));
   return s;
 }
 

@@ -100,12 +100,8 @@ bench::RelocalizationDataset simulated(sim::ScenePreset preset, int frames, uint
   d.map = sim::perturbMap(scene.groundTruthMap(), noise, seed + 1);
   std::mt19937_64 rng(seed + 2);
   for (const Pose& pose : sim::queryTrajectory(scene, frames, seed + 3)) {
-    bench::Query q{"", {}, pose};
     const sim::RenderedFrame f = sim::render(scene, d.K, pose);
-    for (const Detection& det : sim::detect(scene, f, noise, rng))
-      if (auto r = observeDetection(det, d.K.width, d.K.height); r.observation)
-        q.observations.push_back(*r.observation);
-    d.queries.push_back(std::move(q));
+    d.queries.push_back({"", observeDetections(sim::detect(scene, f, noise, rng), d.K.width, d.K.height), pose});
   }
   return d;
 }

@@ -94,18 +94,18 @@ struct ReferenceScore {
   RelocalizationResult given, refined;
 };
 
-/// Observes and relocalizes every frame on `threads` worker threads; `observed` receives each
-/// frame's number of observations, `reference_scores` the score of each frame's reference pose.
+/// Observes and relocalizes every frame on `threads` worker threads; `observations` receives
+/// each frame's observations, `reference_scores` the score of each frame's reference pose.
 std::vector<RelocalizationResult> relocalizeFrames(
     const ObjectRelocalizer& relocalizer, const std::vector<DetectionFrame>& frames,
     const std::vector<std::vector<Keypoint>>& keypoints, const std::optional<GravityPrior>& gravity,
     const ObserveOptions& observe_options, const std::vector<std::optional<Pose>>& references, int threads,
-    const Console& console, std::vector<int>* observed_out, std::vector<ReferenceScore>* reference_scores) {
+    const Console& console, std::vector<std::vector<Observation>>* observations_out,
+    std::vector<ReferenceScore>* reference_scores) {
   // Frames are independent: `threads` workers take the next frame until none is left (the
   // calling thread only shows progress). The first exception of any worker stops the others
   // and is rethrown here, so a worker's failure is reported like the calling thread's.
   std::vector<RelocalizationResult> results(frames.size());
-  std::vector<int>& observed = *observed_out;
   const Intrinsics& K = relocalizer.intrinsics();
   std::atomic<size_t> next(0), finished(0);
   std::atomic<bool> failed(false);
@@ -114,11 +114,8 @@ std::vector<RelocalizationResult> relocalizeFrames(
   const auto work = [&] {
     try {
       for (size_t i = next++; i < frames.size() && !failed; i = next++) {
-        std::vector<Observation> observations;
-        for (const Detection& d : frames[i].detections)
-          if (const ObserveResult r = observeDetection(d, K.width, K.height, observe_options); r.observation)
-            observations.push_back(*r.observation);
-        observed[i] = static_cast<int>(observations.size());
+        const std::vector<Observation>& observations = (*observations_out)[i] =
+            observeDetections(frames[i].detections, K.width, K.height, observe_options);
         results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
         if (references[i])
           (*reference_scores)[i] = {relocalizer.scorePose(observations, *references[i]),
@@ -238,8 +235,9 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
 
 /// The --overlays pictures, one per frame, named by the frame's timestamp.
 void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsics& K,
-                   const std::vector<DetectionFrame>& frames, const std::vector<RelocalizationResult>& results,
-                   const std::vector<std::optional<Pose>>& references, const ObserveOptions& observe_options) {
+                   const std::vector<DetectionFrame>& frames, const std::vector<std::vector<Observation>>& observations,
+                   const std::vector<RelocalizationResult>& results,
+                   const std::vector<std::optional<Pose>>& references) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(a.overlays, ec);
@@ -248,9 +246,7 @@ void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsi
   for (size_t i = 0; i < frames.size(); ++i) {
     const RelocalizationResult& r = results[i];
     io::OverlayContent c;
-    for (const Detection& d : frames[i].detections)
-      if (const ObserveResult o = observeDetection(d, K.width, K.height, observe_options); o.observation)
-        c.observations.push_back(*o.observation);
+    c.observations = observations[i];
     const bool has_pose = r.status == RelocalizationStatus::Success || r.status == RelocalizationStatus::LowEvidence;
     if (has_pose) c.pose = r.pose;
     c.truth = references[i];
@@ -320,11 +316,11 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     }
   }
 
-  std::vector<int> observed(frames.size(), 0);
+  std::vector<std::vector<Observation>> observations(frames.size());
   std::vector<ReferenceScore> reference_scores(frames.size());
   const std::vector<RelocalizationResult> results =
       relocalizeFrames(relocalizer, frames, keypoints, gravity, observe_options, references, a.threads, console,
-                       &observed, &reference_scores);
+                       &observations, &reference_scores);
   console.endProgress();
   std::map<std::string, int> diagnoses;
 
@@ -337,13 +333,13 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     const Pose* reference = references[i] ? &*references[i] : nullptr;
     const std::string diagnosis = reference ? diagnose(r, reference_scores[i], *reference) : "";
     if (reference) ++diagnoses[diagnosis];
-    const nlohmann::json j =
-        frameReport(frames[i], r, observed[i], object_map, reference, reference_scores[i], diagnosis);
+    const nlohmann::json j = frameReport(frames[i], r, static_cast<int>(observations[i].size()), object_map, reference,
+                                         reference_scores[i], diagnosis);
     report.push_back(j);
     if (r.status == RelocalizationStatus::Success) poses.push_back({timestamps[i], r.pose, frames[i].timestampText()});
   }
   io::writeTumTrajectory(a.out, poses);
-  if (!a.overlays.empty()) writeOverlays(a, object_map, K, frames, results, references, observe_options);
+  if (!a.overlays.empty()) writeOverlays(a, object_map, K, frames, observations, results, references);
   if (!a.report.empty()) io::writeFileAtomically(a.report, report.dump(1) + "\n");
   if (!console.quiet)
     std::printf("wrote %s: %zu of %zu frames relocalized (%s), median %.1f ms per frame\n", a.out.c_str(), poses.size(),

@@ -23,10 +23,7 @@ int main(int argc, char** argv) try {
   if (index >= frames.size()) throw Error(std::string(argv[3]) + ": no frame " + std::to_string(index));
 
   // Detections (box, category, score, optional mask) -> observation ellipses.
-  std::vector<Observation> observations;
-  for (const Detection& d : frames[index].detections)
-    if (const ObserveResult r = observeDetection(d, K.width, K.height); r.observation)
-      observations.push_back(*r.observation);
+  const std::vector<Observation> observations = observeDetections(frames[index].detections, K.width, K.height);
 
   // One relocalizer per map; relocalize() is const and thread-safe.
   const ObjectRelocalizer relocalizer(map, K);

@@ -105,11 +105,7 @@ void bindFunctions(py::module_& m) {
         const std::vector<Detection> detections = py::isinstance<DetectionFrame>(frame)
                                                       ? frame.cast<const DetectionFrame&>().detections
                                                       : detectionList(frame, "frame");
-        const ObserveOptions o = optionsFrom(options, policy);
-        std::vector<Observation> out;
-        for (const Detection& d : detections)
-          if (ObserveResult r = observeDetection(d, K.width, K.height, o); r.observation) out.push_back(*r.observation);
-        return out;
+        return observeDetections(detections, K.width, K.height, optionsFrom(options, policy));
       },
       py::arg("frame"), py::arg("camera"), py::arg("policy") = py::none(), py::arg("options") = py::none(),
       "The observations of a DetectionFrame (or a list of Detection), as `ellreloc relocalize` makes them: "

@@ -25,12 +25,8 @@ struct Relocalizer {
   std::string method;
 
   std::vector<Observation> observations(const DetectionFrame& frame) const {
-    std::vector<Observation> out;
     const Intrinsics& K = relocalizer.intrinsics();
-    for (const Detection& d : frame.detections)
-      if (ObserveResult r = observeDetection(d, K.width, K.height, observe); r.observation)
-        out.push_back(*r.observation);
-    return out;
+    return observeDetections(frame.detections, K.width, K.height, observe);
   }
 };
 

@@ -141,4 +141,12 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   return r;
 }
 
+std::vector<Observation> observeDetections(const std::vector<Detection>& detections, int width, int height,
+                                           const ObserveOptions& options) {
+  std::vector<Observation> out;
+  for (const Detection& d : detections)
+    if (ObserveResult r = observeDetection(d, width, height, options); r.observation) out.push_back(*r.observation);
+  return out;
+}
+
 }  // namespace ellreloc

@@ -243,6 +243,13 @@ TEST(Observe, PoliciesAndBadInput) {
   Detection flat = d;
   flat.bbox = Box(10, 10, 10, 20);
   EXPECT_EQ(observeDetection(flat, W, H).status, ObserveStatus::InvalidBox);
+  // A frame's detections: those without an observation are left out, the others kept in order.
+  Detection later = d;
+  later.category_id = d.category_id + 1;
+  const std::vector<Observation> frame = observeDetections({d, outside, nan_box, later, flat}, W, H);
+  ASSERT_EQ(frame.size(), 2u);
+  EXPECT_EQ(frame[0].category, d.category_id);
+  EXPECT_EQ(frame[1].category, later.category_id);
   // Options out of range: a status naming the field, no observation.
   ObserveOptions nan_border;
   nan_border.border_px = NAN;

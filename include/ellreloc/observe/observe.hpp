@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "ellreloc/core/detection.hpp"
 #include "ellreloc/core/observation.hpp"
@@ -60,6 +61,11 @@ struct ObserveResult {
 
 /// Observes one detection of an image of width x height pixels.
 ObserveResult observeDetection(const Detection& detection, int width, int height, const ObserveOptions& options = {});
+
+/// The observations of one image's detections: observeDetection on each, in order, those that
+/// give none (an invalid box, no ellipse) left out.
+std::vector<Observation> observeDetections(const std::vector<Detection>& detections, int width, int height,
+                                           const ObserveOptions& options = {});
 
 /// Fits an ellipse to a run-length mask with the given method (no decoding); `verdict` is
 /// needed by Quadrilateral.
