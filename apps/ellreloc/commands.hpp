@@ -104,6 +104,9 @@ CLI::App* addEvaluateCommand(CLI::App& app, EvaluateArgs& a);
 Evaluation evaluateEstimates(const EvaluateArgs& a);
 /// evaluateEstimates, then --plot and --per-frame.
 Evaluation evaluate(const EvaluateArgs& a);
+/// A frame's status in a method's results: "valid", "wrong" (a pose beyond 30 cm or 30 degrees)
+/// or "no pose".
+const char* frameStatus(const std::optional<PoseError>& error);
 /// The Table-I rows, one per method (the method is the last column).
 void printEvaluation(const Evaluation& e);
 /// Cumulative position and rotation error curves of every method and a top view (plots.cpp).

@@ -65,18 +65,18 @@ void writePerFrame(const std::string& path, const Evaluation& e) {
   for (size_t i = 0; i < e.frames.size(); ++i)
     for (const MethodEvaluation& m : e.methods) {
       const std::optional<PoseError>& err = m.errors[i];
-      csv += csvField(e.frames[i]) + "," + csvField(m.label) + ",";
-      if (!err) {
-        csv += "no pose,,\n";
-        continue;
-      }
-      std::snprintf(numbers, sizeof numbers, "%.3f,%.3f", err->position_cm, err->rotation_deg);
-      csv += std::string(err->valid() ? "valid" : "wrong") + "," + numbers + "\n";
+      numbers[0] = ',', numbers[1] = '\0';  // no pose: empty errors
+      if (err) std::snprintf(numbers, sizeof numbers, "%.3f,%.3f", err->position_cm, err->rotation_deg);
+      csv += csvField(e.frames[i]) + "," + csvField(m.label) + "," + frameStatus(err) + "," + numbers + "\n";
     }
   io::writeFileAtomically(path, csv);
 }
 
 }  // namespace
+
+const char* frameStatus(const std::optional<PoseError>& error) {
+  return !error ? "no pose" : error->valid() ? "valid" : "wrong";
+}
 
 Evaluation evaluateEstimates(const EvaluateArgs& a) {
   std::vector<std::pair<std::string, std::string>> estimates;

@@ -69,8 +69,6 @@ std::string fixed(double v, int digits) {
   return s;
 }
 
-std::string status(const std::optional<PoseError>& e) { return !e ? "no pose" : e->valid() ? "valid" : "wrong"; }
-
 const char* kStyle = R"(
 body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 24px; color: #222; }
 table { border-collapse: collapse; margin: 8px 0 20px; font-size: 13px; }
@@ -131,13 +129,14 @@ void framesTable(std::ostringstream& h, const Evaluation& e) {
     h << "<tr><td>" << html(e.frames[i]) << "</td>";
     for (const MethodEvaluation& m : e.methods) {
       const std::optional<PoseError>& err = m.errors[i];
-      const std::string cls = status(err) == "no pose" ? "no-pose" : status(err);
+      const std::string status = frameStatus(err);
+      const std::string cls = status == "no pose" ? "no-pose" : status;
       if (err)
         h << "<td data-value=\"" << err->position_cm << "\">" << fixed(err->position_cm, 1) << "</td><td data-value=\""
           << err->rotation_deg << "\">" << fixed(err->rotation_deg, 2) << "</td>";
       else  // no pose sorts after every error
         h << "<td data-value=\"1e308\">-</td><td data-value=\"1e308\">-</td>";
-      h << "<td class=\"" << cls << "\">" << status(err) << "</td>";
+      h << "<td class=\"" << cls << "\">" << status << "</td>";
     }
     h << "</tr>\n";
   }
@@ -163,7 +162,7 @@ void worstOverlays(std::ostringstream& h, const Evaluation& e, const std::string
     if (!std::filesystem::is_regular_file(path, ec)) continue;
     const std::optional<PoseError>& err = m.errors[i];
     h << "<figure><img alt=\"overlay of frame " << html(e.frames[i]) << "\" src=\"data:image/png;base64,"
-      << base64(io::readTextFile(path)) << "\"><figcaption>" << html(e.frames[i]) << ": " << status(err);
+      << base64(io::readTextFile(path)) << "\"><figcaption>" << html(e.frames[i]) << ": " << frameStatus(err);
     if (err) h << ", " << fixed(err->position_cm, 1) << " cm, " << fixed(err->rotation_deg, 1) << " deg";
     h << "</figcaption></figure>\n";
     ++shown;
