@@ -16,12 +16,6 @@
 namespace ellreloc::python {
 namespace {
 
-std::string pathFrom(const py::handle& h) {
-  if (!py::isinstance<py::str>(h) && !py::hasattr(h, "__fspath__"))
-    badArgument("path", "expected a str or os.PathLike, got " + describe(h));
-  return py::str(py::module_::import("os").attr("fspath")(h));
-}
-
 io::StampedPose stampedFrom(const py::handle& h) {
   if (py::isinstance<io::StampedPose>(h)) return h.cast<io::StampedPose>();
   if (py::isinstance<py::tuple>(h) && py::len(h) == 2) {

@@ -10,15 +10,15 @@
 #include "ellreloc/observe/observe.hpp"
 
 namespace ellreloc::python {
-namespace {
 
-/// A policy given as ObservationPolicy or as its name.
 ObservationPolicy policyFrom(const py::handle& h) {
   if (py::isinstance<ObservationPolicy>(h)) return h.cast<ObservationPolicy>();
   ObservationPolicy p;
   if (py::isinstance<py::str>(h) && parseObservationPolicy(h.cast<std::string>(), &p)) return p;
   badArgument("policy", "expected 'paper', 'bbox', 'mask' or 'given', got " + std::string(py::repr(h)));
 }
+
+namespace {
 
 ObserveOptions optionsFrom(const std::optional<ObserveOptions>& options, const py::handle& policy) {
   ObserveOptions o = options.value_or(ObserveOptions{});

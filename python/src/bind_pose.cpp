@@ -66,12 +66,7 @@ Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optio
   if (const std::string why = options.validate(); !why.empty()) badArgument("options", why);
   ObserveOptions observe;
   observe.policy = method == "oa-slam" ? ObservationPolicy::Bbox : ObservationPolicy::Paper;
-  if (!policy.is_none()) {
-    const std::string name = py::isinstance<ObservationPolicy>(policy) ? toString(policy.cast<ObservationPolicy>())
-                                                                       : std::string(py::str(policy));
-    if (!parseObservationPolicy(name, &observe.policy))
-      badArgument("policy", "expected 'paper', 'bbox', 'mask' or 'given', got '" + name + "'");
-  }
+  if (!policy.is_none()) observe.policy = policyFrom(policy);
   return Relocalizer{ObjectRelocalizer(std::move(map), K, options), observe, method};
 }
 

@@ -182,7 +182,7 @@ void bindWriter(py::module_& s) {
         o.preset = presetFrom(preset), o.seed = seed, o.noise = noiseLevelFrom(noise);
         if (mapping_frames < 1 || query_frames < 1) badArgument("mapping_frames, query_frames", "must be at least 1");
         o.mapping_frames = mapping_frames, o.query_frames = query_frames, o.write_rgb = write_rgb;
-        const std::string path = py::str(py::module_::import("os").attr("fspath")(dir));
+        const std::string path = pathFrom(dir);
         py::gil_scoped_release release;
         return sim::writeSimulation(path, o);
       },

@@ -10,6 +10,7 @@
 
 #include "ellreloc/core/detection.hpp"
 #include "ellreloc/core/observation.hpp"
+#include "ellreloc/observe/observe.hpp"
 
 namespace ellreloc::python {
 
@@ -29,6 +30,9 @@ RleMask maskFromObject(const py::handle& h, const std::string& name);
 
 /// Keypoints from Keypoint items or an (n, 3) array of (point_index, u, v) (bind_data.cpp).
 std::vector<Keypoint> keypointsFrom(const py::handle& h);
+
+/// A policy given as ObservationPolicy or as its name; ValueError otherwise (bind_observe.cpp).
+ObservationPolicy policyFrom(const py::handle& h);
 
 /// Detections from a list of Detection; ValueError naming `name` otherwise (bind_data.cpp).
 std::vector<Detection> detectionList(const py::handle& h, const std::string& name);

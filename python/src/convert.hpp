@@ -45,6 +45,13 @@ inline std::string shapeText(std::initializer_list<int> dims) {
   return s + (dims.size() == 1 ? ",)" : ")");
 }
 
+/// A path given as str or os.PathLike.
+inline std::string pathFrom(const py::handle& h) {
+  if (!py::isinstance<py::str>(h) && !py::hasattr(h, "__fspath__"))
+    badArgument("path", "expected a str or os.PathLike, got " + describe(h));
+  return py::str(py::module_::import("os").attr("fspath")(h));
+}
+
 /// The argument as a C-contiguous float64 array; converted only when it is not one already.
 inline DoubleArray doubles(const py::handle& h, const std::string& name) {
   if (h.is_none()) badArgument(name, "expected numbers, got None");
