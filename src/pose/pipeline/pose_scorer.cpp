@@ -78,27 +78,37 @@ double PoseScorer::overlapReaching(const Observation& o, const Ellipse& projecte
   return overlap(o, projected, vertices);
 }
 
-double PoseScorer::costLowerBound(int vertices) const {
-  const double miss = options_.unmatched_cost;
-  double bound = miss * candidates_.num_usable;
+template <typename F>
+void PoseScorer::forEachNearbyPair(F f) const {
   for (size_t i = 0; i < observations_.size(); ++i) {
     if (!candidates_.usable[i]) continue;
     const Observation& o = observations_[i];
     const std::vector<int>& cands = candidates_.of_observation[i];
-    double gain = 0.0;  // an observation left unmatched gains nothing
     for (size_t c = 0; c < cands.size(); ++c) {
       const int j = cands[c];
       if (!projects_[j]) continue;
       const Box pb = projected_[j].boundingBox();
       if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
-      const double ub = options_.overlap == OverlapMeasure::BoxIoU
-                            ? boxIoU(o.box, pb)
-                            : ellipseIoUUpperBound(o.ellipse, projected_[j], vertices);
-      if (ub < options_.min_overlap - 1e-9) continue;
-      gain = std::max(gain, miss - 1.0 + std::min(1.0, ub + 1e-9) * label_weight_[i][c]);
+      f(i, c, j);
     }
-    bound -= gain;
   }
+}
+
+double PoseScorer::costLowerBound(int vertices) {
+  const double miss = options_.unmatched_cost;
+  pair_bounds_.clear();
+  best_gain_.assign(observations_.size(), 0.0);  // an observation left unmatched gains nothing
+  forEachNearbyPair([&](size_t i, size_t c, int j) {
+    const Observation& o = observations_[i];
+    const double ub = options_.overlap == OverlapMeasure::BoxIoU
+                          ? boxIoU(o.box, projected_[j].boundingBox())
+                          : ellipseIoUUpperBound(o.ellipse, projected_[j], vertices);
+    pair_bounds_.push_back(ub);
+    if (ub < options_.min_overlap - 1e-9) return;
+    best_gain_[i] = std::max(best_gain_[i], miss - 1.0 + std::min(1.0, ub + 1e-9) * label_weight_[i][c]);
+  });
+  double bound = miss * candidates_.num_usable;
+  for (double gain : best_gain_) bound -= gain;
   return bound;
 }
 
@@ -126,24 +136,22 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     if (p.ok()) projected_[j] = p.ellipse;
   }
   // Most hypotheses are far worse than those kept: bounds show it without an exact overlap.
-  if (give_up_at < std::numeric_limits<double>::infinity() && costLowerBound(vertices) - 1e-9 >= give_up_at) {
+  const bool bounded = give_up_at < std::numeric_limits<double>::infinity();
+  if (bounded && costLowerBound(vertices) - 1e-9 >= give_up_at) {
     if (matches) matches->clear();
     return std::numeric_limits<double>::infinity();
   }
   all_matches_.clear();
-  for (size_t i = 0; i < observations_.size(); ++i) {
-    if (!candidates_.usable[i]) continue;
+  size_t pair = 0;  // the pairs come in the order costLowerBound kept their bounds in
+  forEachNearbyPair([&](size_t i, size_t c, int j) {
     const Observation& o = observations_[i];
-    const std::vector<int>& cands = candidates_.of_observation[i];
-    for (size_t c = 0; c < cands.size(); ++c) {
-      const int j = cands[c];
-      if (!projects_[j]) continue;
-      const Box pb = projected_[j].boundingBox();
-      if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
-      const double ov = overlapReaching(o, projected_[j], vertices, options_.min_overlap);
-      if (ov >= options_.min_overlap) all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
-    }
-  }
+    double ov = 0.0;
+    if (!bounded)
+      ov = overlapReaching(o, projected_[j], vertices, options_.min_overlap);
+    else if (pair_bounds_[pair++] >= options_.min_overlap - 1e-9)  // overlapReaching's test, bound known
+      ov = overlap(o, projected_[j], vertices);
+    if (ov >= options_.min_overlap) all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
+  });
   std::sort(all_matches_.begin(), all_matches_.end(), [](const ObjectCorrespondence& a, const ObjectCorrespondence& b) {
     return a.credit != b.credit
                ? a.credit > b.credit

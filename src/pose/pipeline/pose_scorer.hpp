@@ -55,9 +55,14 @@ class PoseScorer {
   const ScoringOptions& options() const { return options_; }
 
  private:
+  /// f(observation i, candidate c, object j) for each usable observation's candidates that
+  /// project with a box overlapping the observation's, in a fixed order.
+  template <typename F>
+  void forEachNearbyPair(F f) const;
   /// unmatched_cost per usable observation less, for each, the most its best projected
-  /// candidate could gain by the overlap bound: no exact overlap is computed.
-  double costLowerBound(int vertices) const;
+  /// candidate could gain by the overlap bound: no exact overlap is computed. Keeps each pair's
+  /// bound (pair_bounds_, in forEachNearbyPair's order) for the exact pass.
+  double costLowerBound(int vertices);
   const std::vector<Observation>& observations_;
   const Candidates& candidates_;
   const ObjectMap& map_;
@@ -72,6 +77,7 @@ class PoseScorer {
   std::vector<char> projects_;
   std::vector<ObjectCorrespondence> all_matches_;
   std::vector<char> observation_taken_, object_taken_;
+  std::vector<double> pair_bounds_, best_gain_;
 };
 
 }  // namespace ellreloc::pipeline
