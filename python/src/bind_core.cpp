@@ -28,12 +28,6 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0, double
   return text;
 }
 
-Box boxFrom(const py::handle& h, const std::string& name) {
-  if (py::isinstance<Box>(h)) return h.cast<Box>();
-  const Eigen::Vector4d v = vector<4>(h, name + " (x1, y1, x2, y2)");
-  return Box(v(0), v(1), v(2), v(3));
-}
-
 Ellipse makeEllipse(const py::handle& center, const py::handle& axes, double angle) {
   const Eigen::Vector2d c = vector<2>(center, "center"), a = vector<2>(axes, "axes");
   if (!(a.minCoeff() > 0)) badArgument("axes", "semi-axes must be positive");
@@ -338,6 +332,12 @@ void bindEvaluation(py::module_& m) {
 }
 
 }  // namespace
+
+Box boxFrom(const py::handle& h, const std::string& name) {
+  if (py::isinstance<Box>(h)) return h.cast<Box>();
+  const Eigen::Vector4d v = vector<4>(h, name + " (x1, y1, x2, y2)");
+  return Box(v(0), v(1), v(2), v(3));
+}
 
 void bindCore(py::module_& m) {
   bindBoxAndEllipse(m);

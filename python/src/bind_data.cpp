@@ -97,12 +97,7 @@ Detection makeDetection(int category, const py::handle& bbox, double score, cons
                         const std::optional<int>& object_id) {
   Detection d;
   d.category_id = category;
-  if (py::isinstance<Box>(bbox)) {
-    d.bbox = bbox.cast<Box>();
-  } else {
-    const Eigen::Vector4d v = vector<4>(bbox, "bbox (x1, y1, x2, y2)");
-    d.bbox = Box(v(0), v(1), v(2), v(3));
-  }
+  d.bbox = boxFrom(bbox, "bbox");
   if (!std::isfinite(score)) badArgument("score", "must be finite");
   d.score = score;
   if (!mask.is_none()) d.mask = maskFromObject(mask, "mask");

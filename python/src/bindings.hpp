@@ -24,6 +24,9 @@ void bindMapping(py::module_& m);
 void bindIo(py::module_& m);
 void bindSim(py::module_& sim);
 
+/// A Box, or (x1, y1, x2, y2) as any array-like; ValueError naming `name` otherwise (bind_core.cpp).
+Box boxFrom(const py::handle& h, const std::string& name);
+
 /// A mask given as a 2-D bool/uint8 numpy array, a COCO RLE dict ({"size": [h, w], "counts":
 /// str, bytes or list}) or an RleMask; ValueError naming `name` otherwise (bind_data.cpp).
 RleMask maskFromObject(const py::handle& h, const std::string& name);
