@@ -233,15 +233,21 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
   return j;
 }
 
-/// The --overlays pictures, one per frame, named by the frame's timestamp.
+/// The --overlays folder, made before the relocalization so that a bad one fails before any output.
+void makeOverlayFolder(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (!std::filesystem::is_directory(dir))
+    throw FileError(dir + ": cannot create the overlays folder" + (ec ? ": " + ec.message() : std::string()));
+}
+
+/// The --overlays pictures, one per frame, named by the frame's timestamp, in a folder made by
+/// makeOverlayFolder.
 void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsics& K,
                    const std::vector<DetectionFrame>& frames, const std::vector<std::vector<Observation>>& observations,
                    const std::vector<RelocalizationResult>& results,
                    const std::vector<std::optional<Pose>>& references) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(a.overlays, ec);
-  if (ec || !fs::is_directory(a.overlays)) throw FileError(a.overlays + ": cannot create the overlays folder");
   const fs::path images = fs::path(a.detections).parent_path();
   for (size_t i = 0; i < frames.size(); ++i) {
     const RelocalizationResult& r = results[i];
@@ -316,6 +322,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     }
   }
 
+  if (!a.overlays.empty()) makeOverlayFolder(a.overlays);  // inputs read and checked: fail before the work
   std::vector<std::vector<Observation>> observations(frames.size());
   std::vector<ReferenceScore> reference_scores(frames.size());
   const std::vector<RelocalizationResult> results =

@@ -295,6 +295,10 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --min-evidence nan"},
       {"gravity sigma without directions",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --gravity-sigma 5"},
+      {"overlays folder that is a file", reloc + "--map " + d + "/map.json --detections " + d +
+                                             "/keyframes.detections.json --overlays " + dir.path("empty.json")},
+      {"evaluate label left empty", "evaluate --groundtruth " + d + "/keyframes.groundtruth.txt --estimate " + d +
+                                        "/keyframes.groundtruth.txt: " + "--per-frame " + out},
   };
   for (const auto& [name, args] : cases) {
     const CliRun r = run(args, dir);
