@@ -6,7 +6,16 @@ instance masks, or from boxes and poses. Poses are world->camera (Pose.T_cw); TU
 RelocalizationResult.T_wc are camera->world. docs/python.md walks through it.
 """
 
-from ._ellreloc import *  # noqa: F401,F403  (the C++ library's classes and functions)
-from ._ellreloc import sim  # noqa: F401
+import sys
+
+try:
+    import numpy  # noqa: F401  (the extension passes numpy arrays: without it, it cannot load)
+except ImportError as missing:
+    raise ImportError(f"ellreloc needs numpy, which {sys.executable} cannot import; the package was built for "
+                      f"@Python3_EXECUTABLE@ (Python @Python3_VERSION@): run that interpreter, or install numpy "
+                      f"for this one") from missing
+
+from ._ellreloc import *  # noqa: F401,F403,E402  (the C++ library's classes and functions)
+from ._ellreloc import sim  # noqa: F401,E402
 
 __version__ = "@PROJECT_VERSION@"
