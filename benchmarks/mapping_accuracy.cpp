@@ -16,79 +16,33 @@
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
-#include "ellreloc/mapping/hungarian.hpp"
 #include "ellreloc/mapping/mapper.hpp"
 #include "fixtures/sim_sequence.hpp"
+#include "map_scoring.hpp"
 
 using namespace ellreloc;
+using bench::medianOrNan;
 
 namespace {
 
-double medianOrNan(std::vector<double> v) { return ellreloc::median(std::move(v), std::nan("")); }
-
-/// Direction (radians, mod pi) of the longest horizontal extent of an ellipsoid (z up).
-double horizontalYaw(const Ellipsoid& e) {
-  const Eigen::Matrix2d M = e.shapeMatrix().topLeftCorner<2, 2>();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(M);
-  const Eigen::Vector2d v = eig.eigenvectors().col(1);
-  return std::atan2(v.y(), v.x());
-}
-
-struct Errors {
-  std::vector<double> centre, yaw, axis, axis_large;
-  int found = 0, expected = 0, spurious = 0;
+struct Errors : bench::MapErrors {
   double seconds = 0;
   int keyframes = 0;
 };
 
-/// Compares estimated objects with the ground truth objects seen in >= 3 keyframes.
-void score(const std::vector<Ellipsoid>& est, const std::vector<int>& est_category, const sim::Scene& scene,
-           const std::vector<int>& seen, Errors* err) {
-  std::vector<int> gt;
+/// The true objects seen in at least 3 keyframes.
+std::vector<bench::TruthObject> seenObjects(const sim::Scene& scene, const std::vector<int>& seen) {
+  std::vector<bench::TruthObject> truth;
   for (size_t i = 0; i < scene.objects.size(); ++i)
-    if (seen[i] >= 3) gt.push_back(static_cast<int>(i));
-  err->expected += static_cast<int>(gt.size());
-  if (gt.empty() || est.empty()) {
-    err->spurious += static_cast<int>(est.size());
-    return;
-  }
-  Eigen::MatrixXd cost(static_cast<long>(est.size()), static_cast<long>(gt.size()));
-  for (size_t i = 0; i < est.size(); ++i)
-    for (size_t j = 0; j < gt.size(); ++j) {
-      const sim::SimObject& o = scene.objects[static_cast<size_t>(gt[j])];
-      cost(static_cast<long>(i), static_cast<long>(j)) =
-          (est[i].center() - o.box_center).norm() + (est_category[i] == o.category ? 0.0 : 10.0);
-    }
-  const std::vector<int> a = hungarianAssignment(cost);
-  for (size_t i = 0; i < est.size(); ++i) {
-    if (a[i] < 0 || cost(static_cast<long>(i), a[i]) > 0.3) {
-      ++err->spurious;
-      continue;
-    }
-    const sim::SimObject& o = scene.objects[static_cast<size_t>(gt[static_cast<size_t>(a[i])])];
-    ++err->found;
-    err->centre.push_back((est[i].center() - o.box_center).norm());
-    const double aspect = std::max(o.box_half.x(), o.box_half.y()) / std::min(o.box_half.x(), o.box_half.y());
-    if (aspect >= 1.3) {  // the yaw of a square footprint is not defined
-      double d = std::abs(horizontalYaw(est[i]) - horizontalYaw(o.ellipsoid()));
-      d = std::fmod(d, M_PI);
-      err->yaw.push_back(std::min(d, M_PI - d) * 180.0 / M_PI);
-    }
-    const Eigen::Matrix3d M = est[i].shapeMatrix();
-    for (int k = 0; k < 3; ++k) {  // the estimate's extent along each true axis
-      const Eigen::Vector3d u = o.box_rotation.col(k);
-      const double rel = std::abs(std::sqrt(u.dot(M * u)) - o.box_half(k)) / o.box_half(k);
-      err->axis.push_back(rel);
-      if (o.box_half(k) >= 0.05) err->axis_large.push_back(rel);  // at least 2.5 voxels of 2 cm
-    }
-  }
+    if (seen[i] >= 3) truth.push_back({scene.objects[i].category, scene.objects[i].ellipsoid()});
+  return truth;
 }
 
 void printRow(const char* name, const Errors& e) {
   const std::string rate = e.keyframes > 0 ? std::to_string(static_cast<int>(e.keyframes / e.seconds)) : "-";
   std::printf("| %s | %d / %d | %d | %.1f | %.1f | %.1f | %.1f | %s |\n", name, e.found, e.expected, e.spurious,
-              100.0 * medianOrNan(e.centre), medianOrNan(e.yaw), 100.0 * medianOrNan(e.axis), 100.0 * medianOrNan(e.axis_large),
-              rate.c_str());
+              100.0 * medianOrNan(e.centre), medianOrNan(e.yaw), 100.0 * medianOrNan(e.axis),
+              100.0 * medianOrNan(e.axis_large), rate.c_str());
 }
 
 }  // namespace
@@ -126,21 +80,17 @@ int main(int argc, char** argv) {
         const auto t0 = std::chrono::steady_clock::now();
         for (const auto& kf : seq.keyframes) mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
         const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::vector<Ellipsoid> est;
-        std::vector<int> cat;
-        for (const MapObject& o : mapper.map().objects) est.push_back(o.ellipsoid), cat.push_back(o.category);
-        score(est, cat, seq.scene, seen, e);
+        bench::scoreMap(mapper.map().objects, seenObjects(seq.scene, seen), e);
         e->seconds += dt;
         e->keyframes += static_cast<int>(seq.keyframes.size());
       }
       // BoxEllipsoidBuilder alone, with the true associations.
-      std::vector<Ellipsoid> est;
-      std::vector<int> cat;
+      std::vector<MapObject> est;
       for (const auto& [id, v] : views) {
         const BoxEllipsoidResult r = buildEllipsoidFromBoxes(seq.K, v);
-        if (r.ok()) est.push_back(r.ellipsoid), cat.push_back(seq.scene.objects[static_cast<size_t>(id)].category);
+        if (r.ok()) est.push_back({id, seq.scene.objects[static_cast<size_t>(id)].category, "", r.ellipsoid});
       }
-      score(est, cat, seq.scene, seen, &builder);
+      bench::scoreMap(est, seenObjects(seq.scene, seen), &builder);
     }
     const std::string name = sim::toString(preset);
     printRow((name + " / voxel mapper (paper)").c_str(), voxel);
@@ -179,7 +129,7 @@ int main(int argc, char** argv) {
         const Eigen::Vector3d c = o.ellipsoid.center(), a = o.ellipsoid.axes();
         std::printf("| %s (object %d, category %d) | (%.2f, %.2f, %.2f) | (%.2f, %.2f, %.2f) | %.1f | %.0f |\n",
                     toString(mode), o.id, o.category, c.x(), c.y(), c.z(), a.x(), a.y(), a.z(),
-                    horizontalYaw(o.ellipsoid) * 180.0 / M_PI, used / seconds);
+                    bench::horizontalYaw(o.ellipsoid) * 180.0 / M_PI, used / seconds);
       }
     }
   } catch (const std::exception& e) {

@@ -48,6 +48,15 @@ fi
 table real_data python3 scripts/real_data.py "$build"
 table observe_accuracy "$bin/observe_accuracy"
 table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
+# Observations, voxel maps and relocalization on the independent renderer's scene and on two
+# of the project's simulator with the same room preset, noise and mapping keyframe count.
+data=$(sed -n 's/^ELLRELOC_DATA_DIR:[A-Z]*=//p' "$build/CMakeCache.txt")
+for seed in 1 2; do
+  "$build/apps/ellreloc/ellreloc" --quiet simulate --preset office --seed $seed --noise realistic \
+    --mapping-frames 40 --out "$out/scenes/sim_office_$seed"
+done
+table scene_accuracy "$bin/scene_accuracy" "$data/independent_synth/office_s11" "$out/scenes/sim_office_1" \
+  "$out/scenes/sim_office_2"
 python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt")
 if [ -d "$build/python/ellreloc" ] && [ -n "$python" ]; then
   table python_overhead env PYTHONPATH="$build/python" "$python" benchmarks/python_overhead.py

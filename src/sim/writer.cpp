@@ -14,6 +14,7 @@
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
 #include "ellreloc/sim/render.hpp"
+#include "ellreloc/sim/truth.hpp"
 
 namespace ellreloc::sim {
 
@@ -75,7 +76,7 @@ SimulationSummary writeSimulation(const std::string& dir, const SimulationOption
   // Mapping sequence: depth, masks, poses.
   std::ostringstream assoc;
   std::vector<io::StampedPose> mapping_poses;
-  std::vector<DetectionFrame> mapping_dets;
+  std::vector<DetectionFrame> mapping_dets, mapping_truth;
   const auto mapping = mappingTrajectory(scene, opt.mapping_frames);
   for (size_t i = 0; i < mapping.size(); ++i) {
     const double t = 1000.0 + static_cast<double>(i) / 30.0;
@@ -90,6 +91,8 @@ SimulationSummary writeSimulation(const std::string& dir, const SimulationOption
     assoc << stamp(t) << " rgb/" << name << " " << stamp(t) << " depth/" << name << "\n";
     mapping_poses.push_back({t, mapping[i], stamp(t)});
     mapping_dets.push_back({"rgb/" + name, detect(scene, f, noise, rng), {}});
+    mapping_truth.push_back(
+        {"rgb/" + name, detectionTruth(scene, f, opt.camera, mapping[i], mapping_dets.back().detections), {}});
   }
   io::writeFileAtomically(dir + "/mapping/associations.txt", assoc.str());
   wrote("mapping/associations.txt");
@@ -97,11 +100,13 @@ SimulationSummary writeSimulation(const std::string& dir, const SimulationOption
   wrote("mapping/trajectory.txt");
   io::writeDetections(dir + "/mapping/detections.json", mapping_dets);
   wrote("mapping/detections.json");
+  io::writeDetections(dir + "/mapping/ellipse_truth.json", mapping_truth);
+  wrote("mapping/ellipse_truth.json");
   summary.mapping_frames = static_cast<int>(mapping.size());
 
   // Query sequence: detections and ground truth.
   std::vector<io::StampedPose> query_poses;
-  std::vector<DetectionFrame> query_dets;
+  std::vector<DetectionFrame> query_dets, query_truth;
   const auto query = queryTrajectory(scene, opt.query_frames, opt.seed + 2);
   for (size_t i = 0; i < query.size(); ++i) {
     const double t = 2000.0 + 0.5 * static_cast<double>(i);
@@ -114,10 +119,14 @@ SimulationSummary writeSimulation(const std::string& dir, const SimulationOption
     query_poses.push_back({t, query[i], stamp(t)});
     query_dets.push_back(
         {"rgb/" + name, detect(scene, f, noise, rng), keypoints(scene, f, opt.camera, query[i], noise, rng)});
+    query_truth.push_back(
+        {"rgb/" + name, detectionTruth(scene, f, opt.camera, query[i], query_dets.back().detections), {}});
     summary.query_detections += static_cast<int>(query_dets.back().detections.size());
   }
   io::writeDetections(dir + "/query/detections.json", query_dets);
   wrote("query/detections.json");
+  io::writeDetections(dir + "/query/ellipse_truth.json", query_truth);
+  wrote("query/ellipse_truth.json");
   io::writeTumTrajectory(dir + "/query/groundtruth.txt", query_poses);
   wrote("query/groundtruth.txt");
   summary.query_frames = static_cast<int>(query.size());

@@ -83,7 +83,8 @@ inline std::optional<Box> maskBox(const RleMask& rle) {
 inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle) {
   const std::optional<PixelBounds> bounds = maskPixelBounds(rle);
   if (!bounds) return std::nullopt;
-  const auto [xmin, xmax, ymin, ymax] = *bounds;
+  // Plain copies, not a structured binding: C++17 lambdas cannot capture those.
+  const int xmin = bounds->xmin, xmax = bounds->xmax, ymin = bounds->ymin, ymax = bounds->ymax;
   BinaryMask m(ymax - ymin + 1, xmax - xmin + 1);
   m.x0 = xmin;
   m.y0 = ymin;

@@ -10,8 +10,10 @@
 ///     DIR/mapping/rgb/, depth/        colour-coded renderings, 16-bit depth PNGs (5000 / m)
 ///     DIR/mapping/trajectory.txt      TUM, camera->world
 ///     DIR/mapping/detections.json     boxes + instance masks (COCO RLE), with object_id
+///     DIR/mapping/ellipse_truth.json  per detection: true projected ellipse and regular verdict (sim/truth.hpp)
 ///     DIR/query/rgb/                  colour-coded renderings of the query frames
 ///     DIR/query/detections.json       boxes + masks of the query frames, keypoints matched to the map points
+///     DIR/query/ellipse_truth.json    the same truth for the query frames
 ///     DIR/query/groundtruth.txt       TUM, camera->world
 
 #include <cstdint>
