@@ -2,9 +2,10 @@
 // Scores an estimated object map against true objects: each true object is the ellipsoid
 // inscribed in its yaw-only cuboid (axes = the cuboid's half-extents). Estimates are assigned
 // to true objects of the same category by centre distance (Hungarian, within 30 cm); the rest
-// are spurious. Errors: centre distance, yaw of the longest horizontal extent (objects whose
-// footprint has an aspect of at least 1.3 only: a square's yaw is not defined), and the
-// estimate's extent along each true axis relative to the true half-extent.
+// are spurious. Recall counts the objects the map should have (`expected`: seen often enough);
+// an estimate of a real object seen too rarely to be expected is neither found nor spurious. Errors: centre distance,
+// yaw of the longest horizontal extent (objects whose footprint has an aspect of at least 1.3 only: a square's yaw is
+// not defined), and the estimate's extent along each true axis relative to the true half-extent.
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <vector>
@@ -25,24 +26,28 @@ inline double horizontalYaw(const Ellipsoid& e) {
 
 struct TruthObject {
   int category = 0;
-  Ellipsoid ellipsoid;  ///< inscribed in the object's cuboid; rotation yaw-only
+  Ellipsoid ellipsoid;   ///< inscribed in the object's cuboid; rotation yaw-only
+  bool expected = true;  ///< seen often enough that the map should have it
 };
 
 struct MapErrors {
   std::vector<double> centre, yaw, axis, axis_large;
   int found = 0, expected = 0, spurious = 0;
+  int rarely_seen = 0;  ///< estimates of real objects that were not expected
 
   double recall() const { return expected > 0 ? static_cast<double>(found) / expected : std::nan(""); }
+  /// The share of the map's objects that are real objects.
   double precision() const {
-    return found + spurious > 0 ? static_cast<double>(found) / (found + spurious) : std::nan("");
+    const int real = found + rarely_seen;
+    return real + spurious > 0 ? static_cast<double>(real) / (real + spurious) : std::nan("");
   }
 };
 
 inline double medianOrNan(std::vector<double> v) { return ellreloc::median(std::move(v), std::nan("")); }
 
-/// Adds the errors of `estimate` against `truth` (the objects it should have found) to `err`.
+/// Adds the errors of `estimate` against every true object to `err`.
 inline void scoreMap(const std::vector<MapObject>& estimate, const std::vector<TruthObject>& truth, MapErrors* err) {
-  err->expected += static_cast<int>(truth.size());
+  for (const TruthObject& t : truth) err->expected += t.expected;
   if (truth.empty() || estimate.empty()) {
     err->spurious += static_cast<int>(estimate.size());
     return;
@@ -57,6 +62,10 @@ inline void scoreMap(const std::vector<MapObject>& estimate, const std::vector<T
   for (size_t i = 0; i < estimate.size(); ++i) {
     if (a[i] < 0 || cost(static_cast<long>(i), a[i]) > 0.3) {
       ++err->spurious;
+      continue;
+    }
+    if (!truth[static_cast<size_t>(a[i])].expected) {
+      ++err->rarely_seen;
       continue;
     }
     const Ellipsoid& t = truth[static_cast<size_t>(a[i])].ellipsoid;

@@ -30,11 +30,11 @@ struct Errors : bench::MapErrors {
   int keyframes = 0;
 };
 
-/// The true objects seen in at least 3 keyframes.
+/// The true objects; those seen in at least 3 keyframes are expected in the map.
 std::vector<bench::TruthObject> seenObjects(const sim::Scene& scene, const std::vector<int>& seen) {
   std::vector<bench::TruthObject> truth;
   for (size_t i = 0; i < scene.objects.size(); ++i)
-    if (seen[i] >= 3) truth.push_back({scene.objects[i].category, scene.objects[i].ellipsoid()});
+    truth.push_back({scene.objects[i].category, scene.objects[i].ellipsoid(), seen[i] >= 3});
   return truth;
 }
 

@@ -5,11 +5,11 @@
 #include <string>
 #include <vector>
 
+#include "ellreloc/core/observation.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/io/trajectory.hpp"
-#include "ellreloc/core/observation.hpp"
 
 namespace ellreloc::bench {
 

@@ -4,7 +4,7 @@
 //   1. the regular-mask verdict against the truth (a convex quadrilateral outline);
 //   2. observation ellipses against the true projected ellipse: median W2(e, truth) / sqrt(ab)
 //      of the truth, by true class, for the box-inscribed ellipse and the two mask policies;
-//   3. the voxel mapper (all mapping keyframes) against the true objects seen in >= 3 of them;
+//   3. the voxel mapper (all mapping keyframes) against the true objects (expected: seen in >= 3 of them);
 //   4. relocalization of the query frames with the perturbed and the exact map: ours (with
 //      and without the acceptance test), ours with box observations, the OA-SLAM preset, and
 //      ours refined from the true pose (what the observations and the map allow at best).
@@ -85,8 +85,7 @@ void scoreVoxelMap(const bench::SceneFolder& s) {
     for (const Detection& d : f.detections)
       if (d.object_id) ++seen[*d.object_id];
   std::vector<bench::TruthObject> truth;
-  for (const MapObject& o : s.exact_map.objects)
-    if (seen[o.id] >= 3) truth.push_back({o.category, o.ellipsoid});
+  for (const MapObject& o : s.exact_map.objects) truth.push_back({o.category, o.ellipsoid, seen[o.id] >= 3});
 
   MapperOptions options;
   options.mode = MappingMode::Voxel;

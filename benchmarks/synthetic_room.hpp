@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "ellreloc/core/object_map.hpp"
-#include "ellreloc/core/projection.hpp"
 #include "ellreloc/core/observation.hpp"
+#include "ellreloc/core/projection.hpp"
 #include "ellreloc/sim/map_observations.hpp"
 
 namespace ellreloc::bench {

@@ -259,6 +259,49 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     observed(tracks_.back(), d);
     ++report->new_objects;
   }
+  mergeDuplicateVoxelTracks();
+}
+
+void Mapper::mergeDuplicateVoxelTracks() {
+  // A detection that neither 2D tracking nor 3D matching associates starts a new object: an
+  // object first seen from a new side (a loop) has a surface with too few voxels near the
+  // known ones. Once the new object's own surface grows into the old one, the paper's 3D
+  // matching test (eq. 4) recognises them; two objects of one label that pass it are one
+  // object, and the younger joins the older. Only pairs with an object updated in this
+  // keyframe can have changed, so only those are tested.
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    for (size_t j = i + 1; j < tracks_.size(); ++j) {
+      Track &a = tracks_[i], &b = tracks_[j];
+      if (a.last_seen != keyframes_ && b.last_seen != keyframes_) continue;
+      if (a.label() != b.label()) continue;
+      // Centres within the smaller object's mean half-extent, as in mergeDuplicateBoxTracks: an
+      // object that wrongly grew over a neighbour of its label must not swallow it whole.
+      const Eigen::AlignedBox3d ba = a.voxels.bounds(), bb = b.voxels.bounds();
+      if (ba.isEmpty() || bb.isEmpty()) continue;
+      const double reach = 0.5 * std::min(ba.sizes().mean(), bb.sizes().mean());
+      if ((ba.center() - bb.center()).norm() > reach) continue;
+      // A second model of one object lies within the first one's extent (give or take two
+      // voxels); two neighbours side by side or stacked make a box longer than either.
+      const Eigen::Vector3d larger = ba.volume() >= bb.volume() ? ba.sizes() : bb.sizes();
+      if (((ba.merged(bb).sizes() - larger).array() > 2.0 * options_.voxels.voxel_size).any()) continue;
+      // Eq. 4 with the radius of one voxel: two models of one surface share voxels, while
+      // neighbours a few centimetres apart (cups, books) would pass at the tracking radius.
+      TrackingOptions same_surface = options_.tracking;
+      same_surface.match_radius = std::min(same_surface.match_radius, options_.voxels.voxel_size * 1.01);
+      if (!voxelObjectsMatch(a.voxels, b.voxels, same_surface)) continue;
+      a.voxels.absorb(b.voxels);
+      for (const auto& [category, weight] : b.labels) a.labels[category] += weight;
+      a.observations += b.observations;
+      a.last_seen = std::max(a.last_seen, b.last_seen);
+      a.confirmed = a.confirmed || b.confirmed || a.observations >= options_.min_observations;
+      if (a.confirmed) {
+        a.voxels.prune(options_.prune_probability);
+        rebuild(a);
+      }
+      tracks_.erase(tracks_.begin() + static_cast<long>(j));
+      --j;
+    }
+  }
 }
 
 std::vector<int> Mapper::associate2D(const std::vector<std::pair<size_t, Box>>& expected,

@@ -50,8 +50,7 @@ BinaryMask majorityFiltered(const BinaryMask& mask) {
   return out;
 }
 
-std::pair<double, double> VoxelObject::depthGate(const DepthImage& depth, const BinaryMask& mask,
-                                                 int stride) const {
+std::pair<double, double> VoxelObject::depthGate(const DepthImage& depth, const BinaryMask& mask, int stride) const {
   std::pair<double, double> range(options_.min_depth, options_.max_depth);
   if (!(options_.depth_gate_sigmas > 0.0)) return range;
   std::vector<double> d;
@@ -195,6 +194,17 @@ size_t VoxelObject::prune(double probability) {
     }
   }
   return removed;
+}
+
+void VoxelObject::absorb(const VoxelObject& other) {
+  const float l_min = static_cast<float>(logit(options_.clamp_min));
+  const float l_max = static_cast<float>(logit(options_.clamp_max));
+  for (const auto& [key, theirs] : other.voxels_) {
+    Voxel& v = voxels_[key];
+    v.log_odds = std::clamp(v.log_odds + theirs.log_odds, l_min, l_max);
+    v.stamp = frames_;  // counts as touched by this object's latest keyframe, not by a future one
+  }
+  enforceBudget();
 }
 
 size_t VoxelObject::occupiedCount() const {

@@ -123,6 +123,40 @@ TEST(Mapper, AnObjectLeavingAndReenteringTheViewIsFoundAgainIn3D) {
   EXPECT_EQ(map.objects[0].category, 24);
 }
 
+/// A detector that reports one box twice in several keyframes (two overlapping detections of
+/// one label): the second detection cannot join the object the first one already updated, so
+/// it starts a second model of the same surfaces, which then joins the first.
+TEST(Mapper, ASecondModelOfOneObjectJoinsTheFirst) {
+  sim::Scene scene;
+  sim::SimObject box;
+  box.category = 24;
+  box.label = "backpack";
+  box.box_center = Eigen::Vector3d(0.0, 0.0, 0.25);
+  box.box_half = Eigen::Vector3d(0.25, 0.15, 0.25);
+  box.parts.push_back({sim::PrimitiveShape::Box, box.box_center, box.box_half, Eigen::Matrix3d::Identity()});
+  scene.objects.push_back(box);
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  Mapper mapper(K);
+  std::mt19937_64 rng(1);
+  int created = 0;
+  for (int i = 0; i < 10; ++i) {
+    const double a = -0.3 + 0.08 * i;  // an arc around the box
+    const Pose pose = Pose::lookAt(Eigen::Vector3d(2.0 * std::cos(a), 2.0 * std::sin(a), 1.2), box.box_center);
+    const sim::RenderedFrame frame = sim::render(scene, K, pose);
+    std::vector<Detection> detections = sim::detect(scene, frame, sim::NoiseModel(), rng);
+    ASSERT_EQ(detections.size(), 1u);
+    if (i >= 2 && i < 6) detections.push_back(detections[0]);  // reported twice
+    const DepthImage depth = sim::noisyDepth(frame, sim::NoiseModel(), rng);
+    created += mapper.addKeyframe(pose, detections, &depth).new_objects;
+  }
+  EXPECT_EQ(created, 5);  // each repeated detection starts a model, which joins the object at once
+  const ObjectMap map = mapper.map();
+  ASSERT_EQ(map.objects.size(), 1u);
+  EXPECT_EQ(map.objects[0].id, 0);  // the younger joined the older
+  EXPECT_LT((map.objects[0].ellipsoid.center() - box.box_center).norm(), 0.05);
+  EXPECT_EQ(mapper.objects()[0].observations, 14);  // every detection counts once
+}
+
 TEST(Mapper, BoxesOnlyMode) {
   sim::NoiseModel noise;
   noise.box_jitter_px = 1.0;

@@ -43,6 +43,31 @@ TEST(VoxelObject, HitsFollowTheBayesFilterAndClamp) {
   EXPECT_DOUBLE_EQ(v.probabilityAt(Eigen::Vector3d(0, 0, 5)), 0.5);  // unknown
 }
 
+TEST(VoxelObject, AbsorbingAnotherModelAddsItsEvidence) {
+  const Pose camera;
+  const BinaryMask left = rectMask(280, 220, 310, 260), right = rectMask(330, 220, 360, 260);
+  // Two models of one plane from the same keyframe: fused, each voxel holds what one model
+  // integrating that keyframe twice holds (eq. 1 with independent observations: log-odds add).
+  VoxelObject a, b, twice;
+  a.integrate(kK, camera, flatDepth(2.005f), left);
+  b.integrate(kK, camera, flatDepth(2.005f), left);
+  twice.integrate(kK, camera, flatDepth(2.005f), left);
+  twice.integrate(kK, camera, flatDepth(2.005f), left);
+  a.absorb(b);
+  ASSERT_EQ(a.size(), twice.size());
+  for (const Eigen::Vector3d& c : twice.occupiedCentres(0.01))
+    EXPECT_NEAR(a.probabilityAt(c), twice.probabilityAt(c), 1e-6);
+  // A model of another part of the object: its voxels join with their own evidence.
+  VoxelObject other;
+  other.integrate(kK, camera, flatDepth(2.005f), right);
+  a.absorb(other);
+  EXPECT_EQ(a.size(), twice.size() + other.size());
+  for (const Eigen::Vector3d& c : other.occupiedCentres(0.01)) EXPECT_NEAR(a.probabilityAt(c), 0.7, 1e-6);
+  for (const Eigen::Vector3d& c : twice.occupiedCentres(0.01)) EXPECT_NEAR(a.probabilityAt(c), bayes(0.7, 0.7), 1e-6);
+  for (int i = 0; i < 20; ++i) a.absorb(b);
+  EXPECT_NEAR(a.probabilityAt(twice.occupiedCentres(0.01).front()), 0.97, 1e-6);  // clamped as in integrate()
+}
+
 TEST(VoxelObject, VoxelsLieOnTheBackProjectedSurfaceAndProjectToTheMask) {
   VoxelObject v;
   const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));

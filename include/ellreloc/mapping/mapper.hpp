@@ -138,6 +138,7 @@ class Mapper {
   void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report);
   void observed(Track& track, const Detection& detection);
   void mergeDuplicateBoxTracks();
+  void mergeDuplicateVoxelTracks();
   void rebuild(Track& track) const;
 
   Intrinsics K_;

@@ -71,6 +71,12 @@ class VoxelObject {
   /// Removes voxels whose probability is below `probability` (the paper's stage-by-stage filter).
   size_t prune(double probability);
 
+  /// Fuses another model of the same object (same options) into this one: the evidence each
+  /// model holds for a voxel adds up (log-odds sum of eq. 1, clamped as in integrate()). Misses
+  /// the other model's keyframes would have given this model's own voxels are not known, so
+  /// they are not counted.
+  void absorb(const VoxelObject& other);
+
   /// Number of voxels held (any probability).
   size_t size() const { return voxels_.size(); }
   /// Number of voxels at or above options().occupied_probability.
