@@ -82,8 +82,8 @@ TEST(Mapper, LabelNoiseDoesNotSplitObjectsOrChangeTheirLabel) {
   }
 }
 
-/// One box on the floor, seen, then out of view, then seen again from the other side.
-TEST(Mapper, AnObjectLeavingAndReenteringTheViewIsFoundAgainIn3D) {
+/// A scene of one box (a backpack) on the floor.
+sim::Scene oneBoxScene() {
   sim::Scene scene;
   sim::SimObject box;
   box.id = 0;
@@ -93,6 +93,13 @@ TEST(Mapper, AnObjectLeavingAndReenteringTheViewIsFoundAgainIn3D) {
   box.box_half = Eigen::Vector3d(0.25, 0.15, 0.25);
   box.parts.push_back({sim::PrimitiveShape::Box, box.box_center, box.box_half, Eigen::Matrix3d::Identity()});
   scene.objects.push_back(box);
+  return scene;
+}
+
+/// One box on the floor, seen, then out of view, then seen again from the other side.
+TEST(Mapper, AnObjectLeavingAndReenteringTheViewIsFoundAgainIn3D) {
+  const sim::Scene scene = oneBoxScene();
+  const sim::SimObject& box = scene.objects[0];
   const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   std::vector<Pose> poses;
   for (int i = 0; i < 12; ++i) {
@@ -127,14 +134,8 @@ TEST(Mapper, AnObjectLeavingAndReenteringTheViewIsFoundAgainIn3D) {
 /// one label): the second detection cannot join the object the first one already updated, so
 /// it starts a second model of the same surfaces, which then joins the first.
 TEST(Mapper, ASecondModelOfOneObjectJoinsTheFirst) {
-  sim::Scene scene;
-  sim::SimObject box;
-  box.category = 24;
-  box.label = "backpack";
-  box.box_center = Eigen::Vector3d(0.0, 0.0, 0.25);
-  box.box_half = Eigen::Vector3d(0.25, 0.15, 0.25);
-  box.parts.push_back({sim::PrimitiveShape::Box, box.box_center, box.box_half, Eigen::Matrix3d::Identity()});
-  scene.objects.push_back(box);
+  const sim::Scene scene = oneBoxScene();
+  const sim::SimObject& box = scene.objects[0];
   const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   Mapper mapper(K);
   std::mt19937_64 rng(1);
