@@ -194,10 +194,10 @@ TEST(EllipsoidBuilder, MinAreaRectangleYawOnAnLShapedFootprint) {
       pts.push_back(truth.rotation * Eigen::Vector3d(s * 0.4, -0.2, z * 0.3));                  // long face
       if (i % 2 == 0) pts.push_back(truth.rotation * Eigen::Vector3d(-0.4, s * 0.2, z * 0.3));  // short face
     }
-  EllipsoidBuilderOptions rect;
-  rect.yaw = YawMethod::MinAreaRectangle;
-  const auto a = buildEllipsoid(pts, rect);
-  const auto b = buildEllipsoid(pts);
+  EllipsoidBuilderOptions pca;
+  pca.yaw = YawMethod::Pca;
+  const auto a = buildEllipsoid(pts);  // the default: the smallest rectangle
+  const auto b = buildEllipsoid(pts, pca);
   ASSERT_TRUE(a && b);
   EXPECT_LT(axisAngleModPiDeg(a->cuboid.rotation.col(0), truth.rotation.col(0)), 0.01);
   EXPECT_NEAR(a->cuboid.half(0), 0.4, 0.01);

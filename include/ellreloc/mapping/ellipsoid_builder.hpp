@@ -1,8 +1,9 @@
 #pragma once
 /// \file ellipsoid_builder.hpp
 /// The paper's "Accurate Ellipsoids Generation": objects stand on the ground, so their pose
-/// reduces to a yaw about gravity. The yaw is the main axis of a PCA of the object's voxels
-/// projected onto the ground plane; extents along the two ground axes and gravity come from
+/// reduces to a yaw about gravity. The yaw is that of the smallest rectangle around the object's
+/// voxels projected onto the ground plane (the paper: the main axis of their PCA, which
+/// YawMethod::Pca keeps); extents along the two ground axes and gravity come from
 /// robust percentiles of the voxel coordinates; the ellipsoid is the one inscribed in that
 /// cuboid (eqs. 5-6: Q* = Z^T diag(l^2/4, w^2/4, h^2/4, -1) Z).
 
@@ -47,7 +48,9 @@ enum class YawMethod {
 
 struct EllipsoidBuilderOptions {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< against gravity, in world coordinates
-  YawMethod yaw = YawMethod::Pca;
+  /// The smallest rectangle is the default: PCA leans towards the diagonal of a box whose back
+  /// was never seen, and of a square footprint (docs/benchmarks.md, "Object mapping").
+  YawMethod yaw = YawMethod::MinAreaRectangle;
   /// Extents span these percentiles of the voxel coordinates along each axis, which ignores
   /// a few outlier voxels that survived the label filter.
   double low_percentile = 0.01;
