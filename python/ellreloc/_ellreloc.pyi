@@ -102,10 +102,11 @@ class Ellipse:
 
 
 class EllipseMatch:
-    """An observed ellipse and the map ellipsoid it shows."""
-    def __init__(self, observed: Ellipse, ellipsoid: Ellipsoid) -> None: ...
+    """An observed ellipse and the map ellipsoid it shows; sigma is the ellipse's expected error in units of its size (1: a box's ellipse), a smaller one weighs more."""
+    def __init__(self, observed: Ellipse, ellipsoid: Ellipsoid, sigma: float = ...) -> None: ...
     observed: Ellipse
     ellipsoid: Ellipsoid
+    sigma: float
 
 
 class EllipseSource:
@@ -424,6 +425,7 @@ class RefinementOptions:
     top_k: int
     cost_margin: float
     rounds: int
+    regular_mask_sigma: float
     refiner: RefinerOptions
 
 

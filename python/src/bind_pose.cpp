@@ -6,11 +6,13 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <cmath>
 #include <mutex>
 #include <thread>
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "ellreloc/error.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
@@ -208,6 +210,7 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("top_k", &RefinementStageOptions::top_k)
       .def_readwrite("cost_margin", &RefinementStageOptions::cost_margin)
       .def_readwrite("rounds", &RefinementStageOptions::rounds)
+      .def_readwrite("regular_mask_sigma", &RefinementStageOptions::regular_mask_sigma)
       .def_readwrite("refiner", &RefinementStageOptions::refiner);
   py::class_<AcceptanceOptions>(m, "AcceptanceOptions")
       .def(py::init<>())
@@ -375,13 +378,17 @@ void bindRelocalizer(py::module_& m) {
 }
 
 void bindRefiner(py::module_& m) {
-  py::class_<EllipseMatch>(m, "EllipseMatch", "An observed ellipse and the map ellipsoid it shows.")
-      .def(py::init([](const Ellipse& e, const Ellipsoid& q) {
-             return EllipseMatch{e, q};
+  py::class_<EllipseMatch>(m, "EllipseMatch",
+                           "An observed ellipse and the map ellipsoid it shows; sigma is the ellipse's expected "
+                           "error in units of its size (1: a box's ellipse), a smaller one weighs more.")
+      .def(py::init([](const Ellipse& e, const Ellipsoid& q, double sigma) {
+             if (!(std::isfinite(sigma) && sigma > 0)) throw ellreloc::Error("EllipseMatch: sigma must be a positive number");
+             return EllipseMatch{e, q, sigma};
            }),
-           py::arg("observed"), py::arg("ellipsoid"))
+           py::arg("observed"), py::arg("ellipsoid"), py::arg("sigma") = 1.0)
       .def_readwrite("observed", &EllipseMatch::observed)
-      .def_readwrite("ellipsoid", &EllipseMatch::ellipsoid);
+      .def_readwrite("ellipsoid", &EllipseMatch::ellipsoid)
+      .def_readwrite("sigma", &EllipseMatch::sigma);
   py::class_<RefinementResult>(m, "RefinementResult")
       .def_readonly("pose", &RefinementResult::pose)
       .def_readonly("initial_cost", &RefinementResult::initial_cost)

@@ -157,6 +157,9 @@ def test_refinement_and_gravity_results(office):
     observations, objects = E.sim.observe_map(map_, camera, truth)
     matches = [E.EllipseMatch(o.ellipse, map_.objects[j].ellipsoid) for o, j in zip(observations, objects)]
     assert matches[0].observed.center.tolist() == observations[0].ellipse.center.tolist()
+    assert matches[0].sigma == 1.0 and E.EllipseMatch(matches[0].observed, matches[0].ellipsoid, 0.5).sigma == 0.5
+    with pytest.raises(ValueError, match="sigma"):
+        E.EllipseMatch(matches[0].observed, matches[0].ellipsoid, sigma=0.0)
     shifted = truth.T_wc
     shifted[:3, 3] += 0.03
     start = E.Pose.from_T_wc(shifted)

@@ -349,9 +349,10 @@ RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std:
                                gravity->sigma_deg * M_PI / 180.0};
   Problem problem{K, {}, {}, points, options, unit_gravity ? &*unit_gravity : nullptr};
   for (const EllipseMatch& m : objects) {
-    if (!m.observed.isValid() || !project(m.ellipsoid, K, initial)) continue;
+    if (!m.observed.isValid() || !(std::isfinite(m.sigma) && m.sigma > 0) || !project(m.ellipsoid, K, initial))
+      continue;
     problem.objects.push_back(&m);
-    problem.object_scale.push_back(std::sqrt(m.observed.axes().prod()));
+    problem.object_scale.push_back(m.sigma * std::sqrt(m.observed.axes().prod()));
   }
   if (problem.objects.empty() && points.empty()) {
     result.message = "no usable correspondence (no object projects at the initial pose)";

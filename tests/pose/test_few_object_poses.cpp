@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
-#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/few_object_poses.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::positionError;

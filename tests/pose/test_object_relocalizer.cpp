@@ -117,6 +117,9 @@ TEST(ObjectRelocalizer, InvalidOptionsGiveInvalidInputNamingTheField) {
   o = RelocalizerOptions();
   o.refinement.top_k = 0;
   expectRefused(o, "refinement.top_k");
+  o = RelocalizerOptions();
+  o.refinement.regular_mask_sigma = 0.0;
+  expectRefused(o, "refinement.regular_mask_sigma");
 }
 
 TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {

@@ -2,10 +2,10 @@
 #include <ceres/loss_function.h>
 #include <gtest/gtest.h>
 
-#include "fixtures/random_geometry.hpp"
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::positionError;
@@ -139,6 +139,32 @@ TEST(WassersteinRefiner, NormalisationWeighsSmallAndLargeObjectsAlike) {
   ASSERT_EQ(r.object_residuals.size(), 2u);
   EXPECT_NEAR(r.object_residuals[0], r.object_residuals[1], 0.01 * r.object_residuals[1]);
   EXPECT_NEAR(r.object_residuals[0], 0.1 * std::sqrt(2.0) / 1.1, 0.005);  // W2 = 0.1 a sqrt 2, scale 1.1 a
+}
+
+TEST(WassersteinRefiner, SigmaWeighsReliableEllipsesMore) {
+  // Six exact observations and one 20 px off: the pose the refiner settles on moves towards
+  // the wrong one less when the exact ones are declared more reliable (sigma 0.5: 4x the
+  // weight), and not at all when the wrong one is left out (sigma 0).
+  std::mt19937 rng(5);
+  const Intrinsics K = test::testIntrinsics();
+  Scene s = makeScene(rng, 7, 0.0, 0.0);
+  EllipseMatch& wrong = s.matches.back();
+  wrong.observed =
+      Ellipse(wrong.observed.center() + Eigen::Vector2d(20, 0), wrong.observed.axes(), wrong.observed.angle());
+  RefinerOptions opt;
+  opt.object_loss = RobustLoss::None;  // least squares: the weights alone decide
+  const auto errorWith = [&](double exact_sigma, double wrong_sigma) {
+    std::vector<EllipseMatch> m = s.matches;
+    for (EllipseMatch& e : m) e.sigma = exact_sigma;
+    m.back().sigma = wrong_sigma;
+    const RefinementResult r = refinePose(K, s.truth, m, {}, opt);
+    return positionError(r.pose, s.truth);
+  };
+  const double equal = errorWith(1.0, 1.0), reliable = errorWith(0.5, 1.0);
+  EXPECT_GT(equal, 1e-3);
+  EXPECT_LT(reliable, 0.5 * equal);
+  EXPECT_LT(errorWith(1.0, 0.0), 1e-6);  // not a positive sigma: left out, the rest are exact
+  EXPECT_LT(errorWith(1.0, std::nan("")), 1e-6);
 }
 
 TEST(WassersteinRefiner, DegenerateInputIsHandled) {

@@ -68,6 +68,10 @@ struct RefinerOptions {
 struct EllipseMatch {
   Ellipse observed;
   Ellipsoid ellipsoid;
+  /// The observed ellipse's expected error in units of its size (1: a box's ellipse); the
+  /// residual is divided by sigma * sqrt(a b), so a more reliable ellipse weighs more. A
+  /// match whose sigma is not a positive number is left out.
+  double sigma = 1.0;
 };
 
 /// One 2D keypoint matched to a 3D map point.

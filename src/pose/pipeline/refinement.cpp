@@ -21,8 +21,8 @@ ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementC
   const RefinementStageOptions& opt = c.options.refinement;
   for (int round = 0; round < opt.rounds && opt.enabled; ++round) {
     if (static_cast<int>(h.matches.size()) < (c.gravity ? 1 : 2)) break;
-    const RefinementResult r = refinePose(c.K, h.pose, ellipseMatches(h.matches, c.observations, c.map), {},
-                                          opt.refiner, refinementGravity(c, h.matches.size()));
+    const RefinementResult r =
+        refinePose(c.K, h.pose, ellipseMatches(h.matches, c), {}, opt.refiner, refinementGravity(c, h.matches.size()));
     if (r.fell_back || !c.gate.admits(r.pose)) break;
     std::vector<ObjectCorrespondence> rematched;
     const double refined_cost = scorer.cost(r.pose, kReportIoUVertices, &rematched);
@@ -38,12 +38,15 @@ ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementC
 }
 
 std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>& matches,
-                                         const std::vector<Observation>& observations, const ObjectMap& map) {
+                                         const RefinementContext& context) {
   std::vector<EllipseMatch> out;
   out.reserve(matches.size());
-  for (const ObjectCorrespondence& m : matches)
-    out.push_back({observations[static_cast<size_t>(m.observation)].ellipse,
-                   map.objects[static_cast<size_t>(m.object)].ellipsoid});
+  for (const ObjectCorrespondence& m : matches) {
+    const Observation& o = context.observations[static_cast<size_t>(m.observation)];
+    const bool regular_fit = o.source == EllipseSource::Mask && o.regular.value_or(false);
+    out.push_back({o.ellipse, context.map.objects[static_cast<size_t>(m.object)].ellipsoid,
+                   regular_fit ? context.options.refinement.regular_mask_sigma : 1.0});
+  }
   return out;
 }
 
@@ -84,7 +87,7 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
 ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& points, PoseScorer& scorer,
                             const RefinementContext& c) {
   if (points.empty() || !c.options.refinement.enabled || chosen.matches.empty()) return chosen;
-  const RefinementResult r = refinePose(c.K, chosen.pose, ellipseMatches(chosen.matches, c.observations, c.map), points,
+  const RefinementResult r = refinePose(c.K, chosen.pose, ellipseMatches(chosen.matches, c), points,
                                         c.options.refinement.refiner, refinementGravity(c, chosen.matches.size()));
   if (r.fell_back) return chosen;
   std::vector<ObjectCorrespondence> with_points;

@@ -45,8 +45,9 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
 ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& points, PoseScorer& scorer,
                             const RefinementContext& context);
 
-/// The ellipse-ellipsoid pairs of a list of matches, for the refiner.
+/// The ellipse-ellipsoid pairs of a list of matches, for the refiner: ellipses fitted to regular
+/// masks with the sigma of the options (RefinementStageOptions::regular_mask_sigma).
 std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>& matches,
-                                         const std::vector<Observation>& observations, const ObjectMap& map);
+                                         const RefinementContext& context);
 
 }  // namespace ellreloc::pipeline
