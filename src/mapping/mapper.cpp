@@ -263,12 +263,13 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
 }
 
 void Mapper::mergeDuplicateVoxelTracks() {
-  // A detection that neither 2D tracking nor 3D matching associates starts a new object: an
-  // object first seen from a new side (a loop) has a surface with too few voxels near the
-  // known ones. Once the new object's own surface grows into the old one, the paper's 3D
-  // matching test (eq. 4) recognises them; two objects of one label that pass it are one
-  // object, and the younger joins the older. Only pairs with an object updated in this
-  // keyframe can have changed, so only those are tested.
+  // A detection that neither 2D tracking nor 3D matching associates starts a new object: a
+  // second detection of an object another detection already updated in this keyframe, or an
+  // object first seen from a side whose surface has too few voxels near the known ones. Once
+  // the new model's surface overlaps the old one, the paper's 3D matching test (eq. 4)
+  // recognises them; two objects of one label that pass it are one object, and the younger
+  // joins the older. Only pairs with an object updated in this keyframe can have changed, so
+  // only those are tested.
   for (size_t i = 0; i < tracks_.size(); ++i) {
     for (size_t j = i + 1; j < tracks_.size(); ++j) {
       Track &a = tracks_[i], &b = tracks_[j];
