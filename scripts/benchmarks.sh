@@ -51,6 +51,7 @@ table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
 # Observations, voxel maps and relocalization on the independent renderer's scene and on two
 # of the project's simulator with the same room preset, noise and mapping keyframe count.
 data=$(sed -n 's/^ELLRELOC_DATA_DIR:[A-Z]*=//p' "$build/CMakeCache.txt")
+data=$(realpath --relative-to=. "$data")
 for seed in 1 2; do
   "$build/apps/ellreloc/ellreloc" --quiet simulate --preset office --seed $seed --noise realistic \
     --mapping-frames 40 --out "$out/scenes/sim_office_$seed"
