@@ -185,7 +185,7 @@ int main(int argc, char** argv) {
       "| scene | true class | masks | box-inscribed | policy paper | policy mask | box-inscribed, best scale |\n"
       "|---|---|---|---|---|---|---|\n");
   for (size_t i = 0; i < scenes.size(); ++i) printEllipseRows(scenes[i].name, observations[i]);
-  std::printf("\nVoxel map from every mapping keyframe against the true objects seen in at least 3:\n\n");
+  std::printf("\nVoxel map from every mapping keyframe against the true objects (recall: of those seen in at least 3):\n\n");
   std::printf(
       "| scene | keyframes | found | recall | precision | centre cm | yaw deg | axis %% | axis %% (>= 5 cm) |\n"
       "|---|---|---|---|---|---|---|---|---|\n");
