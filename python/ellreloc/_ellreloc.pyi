@@ -137,6 +137,17 @@ class Ellipsoid:
     def sample_surface(self, n: int = ...) -> numpy.ndarray: """n points spread over the surface, as an (n, 3) array."""
 
 
+class EllipsoidBuilderOptions:
+    """How a voxel object becomes an upright ellipsoid (mapping/ellipsoid_builder.hpp)."""
+    def __init__(self) -> None: ...
+    up: numpy.ndarray
+    yaw: YawMethod
+    low_percentile: float
+    high_percentile: float
+    extent_padding: float
+    min_points: int
+
+
 class FewObjectOptions:
     def __init__(self) -> None: ...
     enabled: bool
@@ -248,6 +259,7 @@ class MapperOptions:
     mode: MappingMode
     voxels: VoxelOptions
     tracking: TrackingOptions
+    ellipsoid: EllipsoidBuilderOptions
     min_observations: int
     prune_probability: float
     ellipsoid_min_probability: float
@@ -641,6 +653,17 @@ class VoxelOptions:
     max_depth: float
     pixel_stride: int
     max_voxels: int
+
+
+class YawMethod:
+    """YawMethod"""
+    min_area_rectangle: YawMethod
+    pca: YawMethod
+    name: str
+    value: int
+    def __init__(self, value: int) -> None: ...
+    def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
 
 
 VALID_POSITION_CM: float

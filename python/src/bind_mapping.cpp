@@ -67,11 +67,27 @@ void bindMapperOptions(py::module_& m) {
       .def_readwrite("min_iou_other_label", &TrackingOptions::min_iou_other_label)
       .def_readwrite("match_radius", &TrackingOptions::match_radius)
       .def_readwrite("match_ratio", &TrackingOptions::match_ratio);
+  py::enum_<YawMethod>(m, "YawMethod")
+      .value("min_area_rectangle", YawMethod::MinAreaRectangle, "the smallest rectangle around the footprint (default)")
+      .value("pca", YawMethod::Pca, "the main axis of the footprint's PCA (the paper)");
+  py::class_<EllipsoidBuilderOptions>(m, "EllipsoidBuilderOptions",
+                                      "How a voxel object becomes an upright ellipsoid (mapping/ellipsoid_builder.hpp).")
+      .def(py::init<>())
+      .def_property(
+          "up", [](const EllipsoidBuilderOptions& o) { return toArray(o.up); },
+          [](EllipsoidBuilderOptions& o, const py::handle& up) { o.up = vector<3>(up, "up"); },
+          "against gravity, in world coordinates")
+      .def_readwrite("yaw", &EllipsoidBuilderOptions::yaw)
+      .def_readwrite("low_percentile", &EllipsoidBuilderOptions::low_percentile)
+      .def_readwrite("high_percentile", &EllipsoidBuilderOptions::high_percentile)
+      .def_readwrite("extent_padding", &EllipsoidBuilderOptions::extent_padding)
+      .def_readwrite("min_points", &EllipsoidBuilderOptions::min_points);
   py::class_<MapperOptions>(m, "MapperOptions", "The mapper's options (mapping/mapper.hpp documents each).")
       .def(py::init<>())
       .def_readwrite("mode", &MapperOptions::mode)
       .def_readwrite("voxels", &MapperOptions::voxels)
       .def_readwrite("tracking", &MapperOptions::tracking)
+      .def_readwrite("ellipsoid", &MapperOptions::ellipsoid)
       .def_readwrite("min_observations", &MapperOptions::min_observations)
       .def_readwrite("prune_probability", &MapperOptions::prune_probability)
       .def_readwrite("ellipsoid_min_probability", &MapperOptions::ellipsoid_min_probability)

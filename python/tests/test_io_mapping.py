@@ -117,6 +117,20 @@ def test_voxel_mapping_equals_the_command_line(cli, tmp_path):
     built = E.map_quality(floats.map(), camera, posed)
     assert exact.frames == 12 and exact.boxes == sum(len(d) for _, d in posed)
     assert exact.median_best_iou > moved.median_best_iou and built.median_best_iou > 0.4
+    # The paper's PCA yaw instead of the default rectangle: same objects, other orientations.
+    options = E.MapperOptions()
+    assert options.ellipsoid.yaw == E.YawMethod.min_area_rectangle and options.ellipsoid.up.tolist() == [0, 0, 1]
+    options.ellipsoid.yaw = E.YawMethod.pca
+    pca = E.Mapper(camera, options)
+    for pose, detections, depth_path in mapping_inputs(m):
+        pca.add_keyframe(pose, detections, E.read_depth_png(depth_path))
+    by_id = {o.id: o.ellipsoid for o in floats.map().objects}
+    pca_objects = pca.map().objects
+    assert sorted(o.id for o in pca_objects) == sorted(by_id)
+    turned = [o for o in pca_objects if not np.allclose(o.ellipsoid.rotation, by_id[o.id].rotation)]
+    assert turned and all(np.allclose(o.ellipsoid.center, by_id[o.id].center, atol=0.05) for o in pca_objects)
+    with pytest.raises(ValueError, match="up: expected shape"):
+        options.ellipsoid.up = [0, 1]
 
 
 def test_box_mapping_of_real_frames_equals_the_command_line(data_dir, cli, tmp_path):
