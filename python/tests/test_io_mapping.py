@@ -119,6 +119,7 @@ def test_voxel_mapping_equals_the_command_line(cli, tmp_path):
     assert exact.median_best_iou > moved.median_best_iou and built.median_best_iou > 0.4
     # The paper's PCA yaw instead of the default rectangle: same objects, other orientations.
     options = E.MapperOptions()
+    assert isinstance(options.ellipsoid, E.EllipsoidBuilderOptions)
     assert options.ellipsoid.yaw == E.YawMethod.min_area_rectangle and options.ellipsoid.up.tolist() == [0, 0, 1]
     options.ellipsoid.yaw = E.YawMethod.pca
     pca = E.Mapper(camera, options)
