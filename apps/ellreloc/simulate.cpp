@@ -35,9 +35,9 @@ void simulate(const SimulateArgs& a, const Console& console) {
   if (console.quiet) return;
   std::printf("wrote %s: %d objects, %d mapping frames, %d query frames (%d detections), %zu files\n", a.out.c_str(),
               s.objects, s.mapping_frames, s.query_frames, s.query_detections, s.files.size());
-  for (const char* f :
-       {"camera.yaml", "map_groundtruth.json", "map_perturbed.json", "mapping/associations.txt",
-        "mapping/trajectory.txt", "mapping/detections.json", "query/detections.json", "query/groundtruth.txt"})
+  for (const char* f : {"camera.yaml", "map_groundtruth.json", "map_perturbed.json", "mapping/associations.txt",
+                        "mapping/trajectory.txt", "mapping/detections.json", "query/detections.json",
+                        "query/groundtruth.txt", "query/ellipse_truth.json"})
     std::printf("  %s/%s\n", a.out.c_str(), f);
 }
 
