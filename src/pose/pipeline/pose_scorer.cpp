@@ -11,7 +11,7 @@ namespace ellreloc::pipeline {
 
 PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candidates& candidates, const ObjectMap& map,
                        const Intrinsics& K, const ScoringOptions& options)
-    : observations_(observations), candidates_(candidates), map_(map), K_(K), options_(options) {
+    : observations_(observations), candidates_(candidates), K_(K), options_(options) {
   const auto& cands = candidates.of_observation;
   std::vector<char> relevant(map.objects.size(), 0);
   for (const auto& c : cands)

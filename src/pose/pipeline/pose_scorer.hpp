@@ -65,7 +65,6 @@ class PoseScorer {
   double costLowerBound(int vertices);
   const std::vector<Observation>& observations_;
   const Candidates& candidates_;
-  const ObjectMap& map_;
   const Intrinsics& K_;
   const ScoringOptions& options_;
   std::vector<int> relevant_;                      // objects that are some observation's candidate
