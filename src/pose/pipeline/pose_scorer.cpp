@@ -69,13 +69,11 @@ double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int v
                                                     : ellipseIoU(o.ellipse, projected, vertices);
 }
 
-double PoseScorer::overlapReaching(const Observation& o, const Ellipse& projected, int vertices,
-                                   double threshold) const {
+bool PoseScorer::overlapMayReach(const Observation& o, const Ellipse& projected, int vertices,
+                                 double threshold) const {
   // The margin absorbs the rounding between the bound and the exact overlap.
-  if (options_.overlap == OverlapMeasure::EllipseIoU &&
-      ellipseIoUUpperBound(o.ellipse, projected, vertices) < threshold - 1e-9)
-    return 0.0;
-  return overlap(o, projected, vertices);
+  return options_.overlap != OverlapMeasure::EllipseIoU ||
+         ellipseIoUUpperBound(o.ellipse, projected, vertices) >= threshold - 1e-9;
 }
 
 template <typename F>

@@ -36,7 +36,11 @@ class PoseScorer {
   /// overlap(o, projected, vertices), or 0 when its upper bound already shows that it is below
   /// `threshold` (the exact ellipse IoU costs an atan2 per polygon vertex; the bound a few
   /// operations).
-  double overlapReaching(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
+  double overlapReaching(const Observation& o, const Ellipse& projected, int vertices, double threshold) const {
+    return overlapMayReach(o, projected, vertices, threshold) ? overlap(o, projected, vertices) : 0.0;
+  }
+  /// False when the overlap's upper bound already shows that it is below `threshold`.
+  bool overlapMayReach(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
 
   /// The cost of a pose: unmatched_cost per usable observation, less (unmatched_cost - (1 -
   /// credit)) per one-to-one match, greedy on credit. Fills the matches when asked. When a lower
