@@ -1,10 +1,9 @@
-#include "ellreloc/core/ellipse.hpp"
-
-#include "fixtures/random_geometry.hpp"
-
 #include <gtest/gtest.h>
 
 #include <limits>
+
+#include "ellreloc/core/ellipse.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;
@@ -44,6 +43,31 @@ TEST(Ellipse, GaussianRoundTrip) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(e.covariance());
     EXPECT_NEAR(back->axes()(0), std::sqrt(eig.eigenvalues()(1)), 1e-9 * back->axes()(0));
     EXPECT_NEAR(back->axes()(1), std::sqrt(eig.eigenvalues()(0)), 1e-9 * back->axes()(0));
+  }
+}
+
+TEST(Ellipse, AngleFromAGaussianIsHalfTheAtan2OfItsCovariance) {
+  // The textbook angle of axis a: 0.5 atan2(2 q, p - r), moved into (-pi/2, pi/2].
+  const auto textbook = [](const Eigen::Matrix2d& S) {
+    double angle = 0.5 * std::atan2(2.0 * S(0, 1), S(0, 0) - S(1, 1));
+    return angle <= -M_PI / 2 ? angle + M_PI : angle;
+  };
+  std::mt19937 rng(3);
+  std::vector<Eigen::Matrix2d> covariances;
+  for (int i = 0; i < 1000; ++i) covariances.push_back(ellreloc::test::randomEllipse(rng).covariance());
+  // Axis-aligned either way (angle 0 and pi/2, with q = +0 and -0), a circle (angle 0).
+  for (const double q : {0.0, -0.0}) {
+    covariances.push_back((Eigen::Matrix2d() << 9.0, q, q, 4.0).finished());
+    covariances.push_back((Eigen::Matrix2d() << 4.0, q, q, 9.0).finished());
+    covariances.push_back((Eigen::Matrix2d() << 4.0, q, q, 4.0).finished());
+  }
+  for (const Eigen::Matrix2d& S : covariances) {
+    const auto e = Ellipse::fromGaussian(Eigen::Vector2d(1.0, 2.0), S);
+    ASSERT_TRUE(e.has_value());
+    EXPECT_NEAR(e->angle(), textbook(S), 1e-12) << S;
+    EXPECT_NEAR(e->rotation()(0, 0), std::cos(textbook(S)), 1e-12);
+    EXPECT_NEAR(e->rotation()(1, 0), std::sin(textbook(S)), 1e-12);
+    EXPECT_NEAR((e->covariance() - S).norm(), 0.0, 1e-12 * S.norm());
   }
 }
 

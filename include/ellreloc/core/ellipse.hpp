@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -83,13 +84,22 @@ class Ellipse {
     if (!mean.allFinite() || !cov.allFinite()) return std::nullopt;
     const double p = cov(0, 0), r = cov(1, 1), q = 0.5 * (cov(0, 1) + cov(1, 0));
     // Closed-form eigen decomposition of a symmetric 2x2 matrix.
-    const double half_trace = 0.5 * (p + r);
-    const double radius = std::hypot(0.5 * (p - r), q);
+    const double half_trace = 0.5 * (p + r), half_diff = 0.5 * (p - r);
+    const double radius = std::sqrt(half_diff * half_diff + q * q);
     const double l1 = half_trace + radius, l2 = half_trace - radius;
     if (!(l2 > 0.0) || !(l2 > 1e-12 * l1)) return std::nullopt;
-    double angle = 0.5 * std::atan2(2.0 * q, p - r);  // in (-pi/2, pi/2]
-    if (angle <= -M_PI / 2) angle += M_PI;
-    return Ellipse(mean, Eigen::Vector2d(std::sqrt(l1), std::sqrt(l2)), angle);
+    // Axis a is the eigenvector of l1: (l1 - r, q) = (half_diff + radius, q), or (q, l1 - p) =
+    // (q, radius - half_diff), whichever has no cancellation, turned so that the angle is in
+    // (-pi/2, pi/2] (cosine > 0, or 0 with sine > 0). Projections make ellipses by the thousand
+    // and few need the angle itself: angle() computes it when asked (no atan2, sin, cos here).
+    double c = 1.0, s = 0.0;  // a circle: angle 0
+    if (half_diff >= 0.0 && radius > 0.0) {
+      c = half_diff + radius, s = q;
+    } else if (half_diff < 0.0) {
+      c = q < 0.0 ? -q : q, s = q < 0.0 ? half_diff - radius : radius - half_diff;
+    }
+    const double norm = std::sqrt(c * c + s * s);
+    return Ellipse(mean, Eigen::Vector2d(std::sqrt(l1), std::sqrt(l2)), c / norm, s / norm);
   }
 
   /// The ellipse inscribed in an axis-aligned box (OA-SLAM's observation model).
@@ -101,12 +111,14 @@ class Ellipse {
 
   const Eigen::Vector2d& center() const { return center_; }
   const Eigen::Vector2d& axes() const { return axes_; }
-  double angle() const { return angle_; }
+  /// The angle given to the constructor, or for an ellipse recovered from a conic or Gaussian,
+  /// in (-pi/2, pi/2].
+  double angle() const { return std::isnan(angle_) ? std::atan2(sin_, cos_) : angle_; }
 
   /// Finite parameters and strictly positive semi-axes.
   bool isValid() const {
-    return center_.allFinite() && std::isfinite(angle_) && std::isfinite(axes_(0)) && std::isfinite(axes_(1)) &&
-           axes_(0) > 0.0 && axes_(1) > 0.0;
+    return center_.allFinite() && std::isfinite(cos_) && std::isfinite(sin_) && std::isfinite(axes_(0)) &&
+           std::isfinite(axes_(1)) && axes_(0) > 0.0 && axes_(1) > 0.0;
   }
 
   Eigen::Matrix2d rotation() const {
@@ -172,10 +184,18 @@ class Ellipse {
   }
 
  private:
+  /// From the cosine and sine of the angle (a unit vector); the angle is computed when asked.
+  Ellipse(const Eigen::Vector2d& center, const Eigen::Vector2d& axes, double cos_angle, double sin_angle)
+      : center_(center),
+        axes_(axes),
+        angle_(std::numeric_limits<double>::quiet_NaN()),
+        cos_(cos_angle),
+        sin_(sin_angle) {}
+
   Eigen::Vector2d center_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d axes_ = Eigen::Vector2d::Ones();
-  double angle_ = 0.0;
-  double cos_ = 1.0, sin_ = 0.0;  // of angle_: every rotation and covariance needs them
+  double angle_ = 0.0;            // NaN: not computed, angle() takes it from cos_ and sin_
+  double cos_ = 1.0, sin_ = 0.0;  // of the angle: every rotation and covariance needs them
 };
 
 }  // namespace ellreloc

@@ -31,8 +31,8 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
     const CandidatePair& c = pairs_[static_cast<size_t>(pair_indices[k])];
     const Projection p = scorer_.projectObject(c.object, pose);
     if (!p.ok()) return false;
-    if (check_overlap && !scorer_.overlapMayReach(observations_[c.observation], p.ellipse, kRankingIoUVertices,
-                                                  min_overlap))
+    if (check_overlap &&
+        !scorer_.overlapMayReach(observations_[c.observation], p.ellipse, kRankingIoUVertices, min_overlap))
       return false;
     own->objects[k] = c.object;
     own->ellipses[k] = p.ellipse;

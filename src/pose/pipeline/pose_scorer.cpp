@@ -69,8 +69,7 @@ double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int v
                                                     : ellipseIoU(o.ellipse, projected, vertices);
 }
 
-bool PoseScorer::overlapMayReach(const Observation& o, const Ellipse& projected, int vertices,
-                                 double threshold) const {
+bool PoseScorer::overlapMayReach(const Observation& o, const Ellipse& projected, int vertices, double threshold) const {
   // The margin absorbs the rounding between the bound and the exact overlap.
   return options_.overlap != OverlapMeasure::EllipseIoU ||
          ellipseIoUUpperBound(o.ellipse, projected, vertices) >= threshold - 1e-9;
