@@ -1,12 +1,11 @@
-#include "ellreloc/core/projection.hpp"
-
-#include "fixtures/random_geometry.hpp"
-
 #include <gtest/gtest.h>
+
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
-#include <limits>
+#include "ellreloc/core/projection.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;
@@ -97,10 +96,8 @@ TEST(Projection, FailuresAreStatusesNotNaN) {
 
   EXPECT_TRUE(project(Ellipsoid({0, 0, 3}, {0.2, 0.3, 0.4}, I), K, identity).ok());
   EXPECT_EQ(project(Ellipsoid({0, 0, -3}, {0.2, 0.3, 0.4}, I), K, identity).status, ProjectionStatus::BehindCamera);
-  EXPECT_EQ(project(Ellipsoid({0, 0, 0.1}, {0.5, 0.5, 0.5}, I), K, identity).status,
-            ProjectionStatus::ContainsCamera);
-  EXPECT_EQ(project(Ellipsoid({1, 0, 0.1}, {0.2, 0.2, 0.2}, I), K, identity).status,
-            ProjectionStatus::NotAnEllipse);
+  EXPECT_EQ(project(Ellipsoid({0, 0, 0.1}, {0.5, 0.5, 0.5}, I), K, identity).status, ProjectionStatus::ContainsCamera);
+  EXPECT_EQ(project(Ellipsoid({1, 0, 0.1}, {0.2, 0.2, 0.2}, I), K, identity).status, ProjectionStatus::NotAnEllipse);
   EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, 0.0, 0.4}, I), K, identity).status, ProjectionStatus::InvalidInput);
   EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, -1.0, 0.4}, I), K, identity).status, ProjectionStatus::InvalidInput);
   EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, nan, 0.4}, I), K, identity).status, ProjectionStatus::InvalidInput);
@@ -127,6 +124,31 @@ TEST(Projection, FailuresAreStatusesNotNaN) {
     } else {
       ++failed;
     }
+  }
+  EXPECT_GT(ok, 100);
+  EXPECT_GT(failed, 100);
+}
+
+TEST(Projection, CentreAloneIsTheCentreOfTheWholeProjection) {
+  // Random placements around the camera, in front, behind, around and across it.
+  const Intrinsics K = ellreloc::test::testIntrinsics();
+  const Pose identity;
+  std::mt19937 rng(24);
+  int ok = 0, failed = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Ellipsoid e({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
+                      {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
+                      ellreloc::test::randomRotation(rng));
+    const Projection whole = project(e, K, identity);
+    const std::optional<Eigen::Vector2d> centre =
+        projectedCentre(ProjectableEllipsoid(e), projectionMatrix(K, identity), identity);
+    ASSERT_EQ(centre.has_value(), whole.ok()) << toString(whole.status);
+    if (!whole.ok()) {
+      ++failed;
+      continue;
+    }
+    ++ok;
+    EXPECT_LT((*centre - whole.ellipse.center()).norm(), 1e-9 * (1.0 + whole.ellipse.center().norm()));
   }
   EXPECT_GT(ok, 100);
   EXPECT_GT(failed, 100);

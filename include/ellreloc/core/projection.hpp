@@ -113,6 +113,20 @@ inline Projection projectPrepared(const ProjectableEllipsoid& e, const Eigen::Ma
   return out;
 }
 
+/// The centre of projectPrepared(e, P, pose)'s ellipse, or nullopt where the ellipsoid has no
+/// elliptic image: C*(0:2, 2) / C*(2, 2), the last column of C* = P Q* P^T being P Q* p3 (p3 =
+/// the last row of P). A fraction of the whole projection's cost.
+inline std::optional<Eigen::Vector2d> projectedCentre(const ProjectableEllipsoid& e,
+                                                      const Eigen::Matrix<double, 3, 4>& P, const Pose& pose) {
+  if (!e.valid || e.ellipsoid.contains(pose.center())) return std::nullopt;
+  double near = 0.0, far = 0.0;
+  depthRange<double>(pose.rotation(), pose.translation(), e.ellipsoid.center(), e.shape, &near, &far);
+  if (!(near > 0.0)) return std::nullopt;
+  const Eigen::Vector3d last = P * (e.dual_quadric * P.row(2).transpose());
+  if (!last.allFinite() || !(std::abs(last(2)) > 0.0)) return std::nullopt;
+  return Eigen::Vector2d(last(0) / last(2), last(1) / last(2));
+}
+
 /// Projects an ellipsoid with a world->camera pose. The image is an ellipse exactly when the
 /// ellipsoid lies strictly in front of the camera's principal plane (z_c > 0 everywhere);
 /// every other case returns a status, never a NaN.

@@ -3,6 +3,7 @@
 // poses, refinement, scorePose) ranks poses with it.
 
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "candidates.hpp"
@@ -54,6 +55,12 @@ class PoseScorer {
   Projection projectObject(int j, const Pose& pose) const {
     if (!K_.isValid() || !pose.isValid()) return Projection{};
     return projectPrepared(prepared_[static_cast<size_t>(j)], projectionMatrix(K_, pose), pose);
+  }
+
+  /// The centre of projectObject(j, pose)'s ellipse, computed alone (projectedCentre).
+  std::optional<Eigen::Vector2d> projectedCentre(int j, const Pose& pose) const {
+    if (!K_.isValid() || !pose.isValid()) return std::nullopt;
+    return ellreloc::projectedCentre(prepared_[static_cast<size_t>(j)], projectionMatrix(K_, pose), pose);
   }
 
   const ScoringOptions& options() const { return options_; }
