@@ -181,6 +181,29 @@ TEST(EllipseIoU, UpperBoundHoldsAndPrunes) {
   EXPECT_NEAR(ellipseIoUUpperBound(Ellipse({0, 0}, {2, 1}, 0), Ellipse({0, 0}, {2, 1}, 0)), 1.0, 1e-12);
 }
 
+// The bound the relocalizer's sample check uses to skip the exact overlap: never above the IoU
+// it stands for, and high enough to settle most pairs that reach 0.15.
+TEST(EllipseIoU, LowerBoundHoldsAndSettles) {
+  std::mt19937 rng(137);
+  int settled = 0, reaching = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Ellipse a = test::randomEllipse(rng);
+    const Ellipse b(
+        a.center() + Eigen::Vector2d(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1)) * a.axes().maxCoeff(),
+        a.axes().cwiseProduct(Eigen::Vector2d(test::uniform(rng, 0.3, 2), test::uniform(rng, 0.3, 2))),
+        a.angle() + test::uniform(rng, -0.5, 0.5));
+    for (int vertices : {32, 128}) {
+      const double iou = ellipseIoU(a, b, vertices), bound = ellipseIoULowerBound(a, b, vertices);
+      ASSERT_LE(bound, iou + 1e-12) << i << " " << vertices;
+      ASSERT_GE(bound, 0.0);
+      if (vertices == 32 && iou >= 0.15) ++reaching, settled += bound >= 0.15;
+    }
+  }
+  EXPECT_GT(settled, reaching / 4);
+  EXPECT_EQ(ellipseIoULowerBound(Ellipse({0, 0}, {1, 1}, 0), Ellipse({1.5, 0}, {1, 1}, 0)), 0.0);
+  EXPECT_GT(ellipseIoULowerBound(Ellipse({0, 0}, {2, 1}, 0.3), Ellipse({0, 0}, {2, 1}, 0.3), 32), 0.98);
+}
+
 TEST(EllipseIoU, FastAtan2IsWithin2e8OfStdAtan2) {
   std::mt19937 rng(136);
   double worst = 0.0;

@@ -1,9 +1,10 @@
+#include "ellreloc/core/ellipse.hpp"
+
+#include "fixtures/random_geometry.hpp"
+
 #include <gtest/gtest.h>
 
 #include <limits>
-
-#include "ellreloc/core/ellipse.hpp"
-#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 using ellreloc::test::uniform;

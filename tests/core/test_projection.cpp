@@ -1,11 +1,12 @@
-#include <gtest/gtest.h>
+#include "ellreloc/core/projection.hpp"
 
-#include <limits>
+#include "fixtures/random_geometry.hpp"
+
+#include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
-#include "ellreloc/core/projection.hpp"
-#include "fixtures/random_geometry.hpp"
+#include <limits>
 
 using namespace ellreloc;
 using ellreloc::test::uniform;

@@ -234,6 +234,32 @@ inline double ellipseIoUUpperBound(const Ellipse& e1, const Ellipse& e2, int ver
   return inter / (a1 + a2 - inter);
 }
 
+/// A lower bound of ellipseIoU(e1, e2, vertices), a few operations instead of one atan2 per
+/// vertex, to accept pairs that certainly reach a threshold. In the frame where the larger
+/// ellipse is the unit disc and the smaller's centre lies at radius rho < 1, the disc contains
+/// the disc of radius 1 - rho around that centre, and the polygon contains the smaller ellipse
+/// shrunk by k cos(pi/n) (semi-axes r1 >= r2): both contain the ellipse of semi-axes
+/// min(r1, 1 - rho), min(r2, 1 - rho) around it.
+inline double ellipseIoULowerBound(const Ellipse& e1, const Ellipse& e2, int vertices = 128) {
+  if (!e1.isValid() || !e2.isValid() || vertices < 3) return 0.0;
+  const double a1 = e1.area(), a2 = e2.area();
+  const Ellipse& small = a1 < a2 ? e1 : e2;
+  const Ellipse& big = a1 < a2 ? e2 : e1;
+  const Eigen::Matrix2d to_disc = big.axes().cwiseInverse().asDiagonal() * big.rotation().transpose();
+  const double rho = (to_disc * (small.center() - big.center())).norm();
+  if (!(rho < 1.0)) return 0.0;
+  const detail::PolygonConstants polygon = detail::polygonConstants(vertices);
+  const Eigen::Matrix2d M = polygon.k * std::cos(M_PI / vertices) * to_disc * small.rotation() *
+                            small.axes().asDiagonal();
+  // Singular values of the 2x2 M from its Frobenius norm and determinant.
+  const double f = M.squaredNorm(), d = std::abs(M.determinant());
+  const double root = std::sqrt(std::max(0.0, f * f - 4.0 * d * d));
+  const double r1 = std::sqrt(0.5 * (f + root)), r2 = d / std::max(r1, 1e-300);
+  const double inter = std::min(M_PI * std::min(r1, 1.0 - rho) * std::min(r2, 1.0 - rho) * big.axes().prod(),
+                                small.area());
+  return inter / (a1 + a2 - inter);
+}
+
 /// Level-set distance between two ellipses, after Zins et al. (IROS 2022, "Level set-based
 /// camera pose estimation from multiple 2D/3D ellipse-ellipsoid correspondences"): points are
 /// sampled on the level sets rho_a = s (s in {1/2, 1, 3/2}) of each ellipse's Mahalanobis

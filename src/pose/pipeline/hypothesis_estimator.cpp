@@ -39,8 +39,10 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
     own->count = k + 1;
   }
   for (int k = 0; k < count && check_overlap; ++k)
-    if (scorer_.overlap(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k], kRankingIoUVertices) <
-        min_overlap)
+    if (!scorer_.overlapCertainlyReaches(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k],
+                                         kRankingIoUVertices, min_overlap) &&
+        scorer_.overlap(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k], kRankingIoUVertices) <
+            min_overlap)
       return false;
   return true;
 }

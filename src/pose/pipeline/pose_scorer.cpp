@@ -75,6 +75,12 @@ bool PoseScorer::overlapMayReach(const Observation& o, const Ellipse& projected,
          ellipseIoUUpperBound(o.ellipse, projected, vertices) >= threshold - 1e-9;
 }
 
+bool PoseScorer::overlapCertainlyReaches(const Observation& o, const Ellipse& projected, int vertices,
+                                         double threshold) const {
+  return options_.overlap == OverlapMeasure::EllipseIoU &&
+         ellipseIoULowerBound(o.ellipse, projected, vertices) >= threshold + 1e-9;
+}
+
 template <typename F>
 void PoseScorer::forEachNearbyPair(F f) const {
   for (size_t i = 0; i < observations_.size(); ++i) {

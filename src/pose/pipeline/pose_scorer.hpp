@@ -42,6 +42,8 @@ class PoseScorer {
   }
   /// False when the overlap's upper bound already shows that it is below `threshold`.
   bool overlapMayReach(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
+  /// True when the overlap's lower bound already shows that it reaches `threshold`.
+  bool overlapCertainlyReaches(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
 
   /// The cost of a pose: unmatched_cost per usable observation, less (unmatched_cost - (1 -
   /// credit)) per one-to-one match, greedy on credit. Fills the matches when asked. When a lower
