@@ -52,8 +52,7 @@ RealSet fr3() {
   options.mode = MappingMode::Boxes;
   Mapper mapper(s.K, options);
   for (size_t i = 0; i < frames.size(); i += 2)
-    if (const auto k = io::findNearest(truth, *frames[i].timestamp()))
-      mapper.addKeyframe(truth[*k].pose, frames[i].detections);
+    if (const Pose* pose = io::framePose(truth, frames[i])) mapper.addKeyframe(*pose, frames[i].detections);
   mapper.finish();
   s.map = mapper.map();
   for (size_t i = 1; i < frames.size(); i += 10)

@@ -116,12 +116,11 @@ int main(int argc, char** argv) {
       double seconds = 0;
       int used = 0;
       for (const auto& f : frames_) {
-        const auto t = f.timestamp();
-        const auto k = t ? io::findNearest(gt, *t) : std::nullopt;
-        if (!k) continue;
+        const Pose* pose = io::framePose(gt, f);
+        if (!pose) continue;
         const DepthImage depth = io::readDepthPng(dir + "depth/" + f.timestampText() + ".png");
         const auto t0 = std::chrono::steady_clock::now();
-        mapper.addKeyframe(gt[*k].pose, f.detections, &depth);
+        mapper.addKeyframe(*pose, f.detections, &depth);
         seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         ++used;
       }

@@ -35,9 +35,9 @@ inline RelocalizationDataset loadFr2Desk(const std::string& data_dir) {
   d.K = io::readCamera(dir + "camera.yaml");
   const auto poses = io::readTumTrajectory(dir + "keyframes.groundtruth.txt");
   for (const DetectionFrame& f : io::readDetections(dir + "keyframes.detections.json")) {
-    const auto k = io::findNearest(poses, f.timestamp().value_or(-1.0));
-    if (!k) continue;
-    Query q{f.timestampText(), {}, poses[*k].pose};
+    const Pose* pose = io::framePose(poses, f);
+    if (!pose) continue;
+    Query q{f.timestampText(), {}, *pose};
     for (const Detection& det : f.detections) {
       if (auto o = observationFromBox(det.category_id, det.score, det.bbox, d.K.width, d.K.height))
         q.observations.push_back(*o);

@@ -109,7 +109,7 @@ ObjectMap scoreVoxelMap(const bench::SceneFolder& s) {
   Mapper mapper(s.K, options);
   int keyframes = 0;
   for (const DetectionFrame& f : s.mapping) {
-    const Pose* pose = bench::truePose(s.mapping_poses, f);
+    const Pose* pose = io::framePose(s.mapping_poses, f);
     const auto depth = s.depth_of_rgb.find(f.file_name);
     if (!pose || depth == s.depth_of_rgb.end()) continue;
     const DepthImage image = io::readDepthPng(depth->second);
@@ -129,7 +129,7 @@ void relocalizeRow(const bench::SceneFolder& s, const char* map_name, const Obje
   const ObjectRelocalizer reloc(map, s.K, options);
   std::vector<std::optional<PoseError>> errors;
   for (const DetectionFrame& f : s.query) {
-    const Pose* truth = bench::truePose(s.query_poses, f);
+    const Pose* truth = io::framePose(s.query_poses, f);
     if (!truth) continue;
     const std::vector<Observation> obs = observeDetections(f.detections, s.K.width, s.K.height, withPolicy(policy));
     const RelocalizationResult r = from_truth ? reloc.refineFrom(obs, *truth) : reloc.relocalize(obs);
@@ -185,7 +185,8 @@ int main(int argc, char** argv) {
       "| scene | true class | masks | box-inscribed | policy paper | policy mask | box-inscribed, best scale |\n"
       "|---|---|---|---|---|---|---|\n");
   for (size_t i = 0; i < scenes.size(); ++i) printEllipseRows(scenes[i].name, observations[i]);
-  std::printf("\nVoxel map from every mapping keyframe against the true objects (recall: of those seen in at least 3):\n\n");
+  std::printf(
+      "\nVoxel map from every mapping keyframe against the true objects (recall: of those seen in at least 3):\n\n");
   std::printf(
       "| scene | keyframes | found | recall | precision | centre cm | yaw deg | axis %% | axis %% (>= 5 cm) |\n"
       "|---|---|---|---|---|---|---|---|---|\n");

@@ -73,11 +73,4 @@ inline const Detection* truthOf(const std::vector<DetectionFrame>& truth, const 
   return nullptr;
 }
 
-/// The true pose of a frame, by the timestamp of its file name; nullptr when there is none.
-inline const Pose* truePose(const std::vector<io::StampedPose>& poses, const DetectionFrame& f) {
-  const std::optional<double> t = f.timestamp();
-  const std::optional<size_t> k = t ? io::findNearest(poses, *t) : std::nullopt;
-  return k ? &poses[*k].pose : nullptr;
-}
-
 }  // namespace ellreloc::bench

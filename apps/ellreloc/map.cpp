@@ -30,11 +30,8 @@ std::string absoluteNormal(const fs::path& p) { return fs::absolute(p).lexically
 std::vector<PosedDetections> posedFrames(const std::vector<DetectionFrame>& frames,
                                          const std::vector<io::StampedPose>& trajectory) {
   std::vector<PosedDetections> out;
-  for (const DetectionFrame& f : frames) {
-    const std::optional<double> t = f.timestamp();
-    const std::optional<size_t> k = t ? io::findNearest(trajectory, *t) : std::nullopt;
-    if (k) out.push_back({trajectory[*k].pose, f.detections});
-  }
+  for (const DetectionFrame& f : frames)
+    if (const Pose* pose = io::framePose(trajectory, f)) out.push_back({*pose, f.detections});
   return out;
 }
 

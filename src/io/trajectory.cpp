@@ -76,4 +76,10 @@ std::optional<size_t> findNearest(const std::vector<StampedPose>& poses, double 
   return best;
 }
 
+const Pose* framePose(const std::vector<StampedPose>& poses, const DetectionFrame& frame, double tolerance) {
+  const std::optional<double> t = frame.timestamp();
+  const std::optional<size_t> k = t ? findNearest(poses, *t, tolerance) : std::nullopt;
+  return k ? &poses[*k].pose : nullptr;
+}
+
 }  // namespace ellreloc::io

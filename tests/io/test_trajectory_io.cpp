@@ -43,6 +43,23 @@ TEST(TrajectoryIo, RoundTripAndNearestTimestamp) {
   EXPECT_EQ(io::findNearest(back, 0.0), std::nullopt);
 }
 
+TEST(TrajectoryIo, AFramesPoseIsTheOneNearestToItsFileNamesTimestamp) {
+  std::vector<io::StampedPose> poses(3);
+  for (int i = 0; i < 3; ++i) {
+    poses[i].timestamp = 100.0 + i;
+    poses[i].pose = Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(i, 0, 0));
+  }
+  const auto frame = [](const std::string& name) { return DetectionFrame{name, {}, {}}; };
+  const Pose* p = io::framePose(poses, frame("rgb/101.01.png"));
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p, &poses[1].pose);
+  EXPECT_EQ(io::framePose(poses, frame("depth/99.99.png")), &poses[0].pose);
+  EXPECT_EQ(io::framePose(poses, frame("rgb/101.5.png")), nullptr);       // beyond the 0.02 s tolerance
+  EXPECT_EQ(io::framePose(poses, frame("rgb/101.4.png"), 0.6), &poses[1].pose);
+  EXPECT_EQ(io::framePose(poses, frame("rgb/frame_0001.png")), nullptr);  // no timestamp in the name
+  EXPECT_EQ(io::framePose({}, frame("rgb/101.png")), nullptr);
+}
+
 TEST(TrajectoryIo, ReadsTheFr2Keyframes) {
   const auto poses = io::readTumTrajectory(test::dataPath("tum_fr2_desk/keyframes.groundtruth.txt"));
   EXPECT_EQ(poses.size(), 198u);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ellreloc/core/camera.hpp"
+#include "ellreloc/core/detection.hpp"
 
 namespace ellreloc::io {
 
@@ -31,5 +32,9 @@ void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>&
 
 /// Index of the pose whose timestamp is nearest to t, if within `tolerance` seconds.
 std::optional<size_t> findNearest(const std::vector<StampedPose>& poses, double t, double tolerance = 0.02);
+
+/// The pose of a detection frame: the trajectory's pose nearest to the timestamp of the frame's
+/// file name, within `tolerance` seconds; nullptr when there is none (or no timestamp).
+const Pose* framePose(const std::vector<StampedPose>& poses, const DetectionFrame& frame, double tolerance = 0.02);
 
 }  // namespace ellreloc::io
