@@ -65,10 +65,11 @@ void map(const MapArgs& a, const Console& console);
 
 struct RelocalizeArgs {
   std::string camera, map, detections, method = "ours", out, report, policy;
-  std::string reference;    ///< TUM poses to diagnose each frame against (search or scoring failure)
-  std::string envelope;     ///< TUM trajectory of the mapping keyframes: poses outside their envelope are dropped
-  bool use_points = false;  ///< refine with the frames' keypoints matched to the map's points
-  std::string points;       ///< a file with the keypoints; empty: the detections file's own
+  std::string reference;         ///< TUM poses to diagnose each frame against (search or scoring failure)
+  std::string envelope;          ///< TUM trajectory of the mapping keyframes: poses outside their envelope are dropped
+  bool no_map_envelope = false;  ///< ignore the map's own camera envelope
+  bool use_points = false;       ///< refine with the frames' keypoints matched to the map's points
+  std::string points;            ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;
   double max_time_ms = 0.0;  ///< wall-clock budget of each frame's search; 0: none
   double min_evidence = AcceptanceOptions().min_evidence;

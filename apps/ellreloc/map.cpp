@@ -63,6 +63,11 @@ void printSummary(const ObjectMap& map, const std::vector<std::string>& dropped,
   std::printf("  objects: %s\n", line.empty() ? "none" : line.c_str());
   std::printf("  left out: %zu degenerate object(s)%s%s; %d candidate(s) seen fewer than %d times\n", dropped.size(),
               dropped.empty() ? "" : ": ", joined(dropped).c_str(), stats.candidates, min_observations);
+  if (const auto& e = map.camera_envelope)
+    std::printf(
+        "  camera envelope (relocalization keeps to it): heights %.2f to %.2f m along up (%.3f, %.3f, %.3f), "
+        "tilts %.0f to %.0f deg\n",
+        e->min_height, e->max_height, e->up(0), e->up(1), e->up(2), e->min_tilt_deg, e->max_tilt_deg);
 }
 
 }  // namespace

@@ -43,8 +43,12 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
       ->check(CLI::ExistingFile);
   r->add_option("--envelope", a.envelope,
                 "TUM trajectory of the mapping keyframes: poses outside their heights and tilts (+-0.5 m, +-20 deg; "
-                "up from --map-up, else the keyframes' mean image-up) are never hypotheses")
+                "up from --map-up, else the keyframes' mean image-up) are never hypotheses; without it, the "
+                "map's own camera_envelope (maps built by ellreloc map record one) keeps the camera where the map "
+                "was made")
       ->check(CLI::ExistingFile);
+  r->add_flag("--no-map-envelope", a.no_map_envelope,
+              "ignore the map's camera_envelope: poses anywhere (the oa-slam method always does)");
   r->add_option("--points", a.points,
                 "refine with keypoints matched to the map's points: from this file (same frame "
                 "layout), or from the detections file when no file is given")
@@ -157,7 +161,7 @@ std::string diagnose(const RelocalizationResult& result, const ReferenceScore& r
   return best < result.cost ? "search failure" : "scoring failure";
 }
 
-/// The options of --method, --max-time-ms and --envelope; `policy` gets the method's default.
+/// The options of --method, --max-time-ms, --envelope and --no-map-envelope; `policy` gets the method's default.
 RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* policy_out) {
   RelocalizerOptions options;
   if (a.method == "oa-slam") {
@@ -174,6 +178,7 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
     options.acceptance.min_evidence = a.min_evidence;
     options.acceptance.enabled = !a.accept_all;
   }
+  if (a.no_map_envelope) options.map_envelope = false;
   if (!a.envelope.empty()) {
     std::vector<Pose> keyframes;
     for (const io::StampedPose& p : io::readTumTrajectory(a.envelope)) keyframes.push_back(p.pose);

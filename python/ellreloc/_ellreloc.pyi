@@ -316,6 +316,7 @@ class ObjectMap:
     def __init__(self, objects: list[MapObject] = ..., points: ArrayLike = ...) -> None: ...
     objects: list[MapObject]
     points: numpy.ndarray
+    camera_envelope: Optional[ellreloc::CameraEnvelope]
     def __len__(self) -> int: ...
 
 
@@ -551,6 +552,7 @@ class RelocalizerOptions:
     refinement: RefinementOptions
     acceptance: AcceptanceOptions
     envelope: Optional[CameraEnvelope]
+    map_envelope: bool
     def validate(self) -> str: """'' when every field is in range, else the first that is not."""
 
 

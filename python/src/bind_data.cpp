@@ -241,6 +241,9 @@ void bindObservationAndMap(py::module_& m) {
       .def_property(
           "points", [](const ObjectMap& map) { return rowsToArray<3>(map.points); },
           [](ObjectMap& map, const py::handle& h) { map.points = rows<3>(h, "points"); }, "(n, 3) map points.")
+      .def_readwrite("camera_envelope", &ObjectMap::camera_envelope,
+                     "Where the map's keyframes were taken (a CameraEnvelope; maps built by a Mapper have one), or "
+                     "None. The relocalizer keeps the camera within it unless told otherwise.")
       .def("__len__", [](const ObjectMap& map) { return map.objects.size(); })
       .def("__repr__", [](const ObjectMap& map) {
         return "ObjectMap(" + std::to_string(map.objects.size()) + " objects, " + std::to_string(map.points.size()) +

@@ -57,12 +57,14 @@ Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optio
     const std::string name = py::str(key);
     if (name == "envelope") {
       options.envelope = value.is_none() ? std::nullopt : std::optional<CameraEnvelope>(value.cast<CameraEnvelope>());
+    } else if (name == "map_envelope") {
+      options.map_envelope = value.cast<bool>();
     } else if (name == "search" || name == "scoring" || name == "few_objects" || name == "gravity" ||
                name == "refinement" || name == "acceptance") {
       setGroup(handle.attr(name.c_str()), name, value);
     } else {
       throw py::type_error("unknown option group '" + name +
-                           "' (search, scoring, few_objects, gravity, refinement, acceptance, envelope)");
+                           "' (search, scoring, few_objects, gravity, refinement, acceptance, envelope, map_envelope)");
     }
   }
   if (const std::string why = options.validate(); !why.empty()) badArgument("options", why);
@@ -277,7 +279,11 @@ void bindOptions(py::module_& m) {
       .def_readwrite("gravity", &RelocalizerOptions::gravity)
       .def_readwrite("refinement", &RelocalizerOptions::refinement)
       .def_readwrite("acceptance", &RelocalizerOptions::acceptance)
-      .def_readwrite("envelope", &RelocalizerOptions::envelope)
+      .def_readwrite("envelope", &RelocalizerOptions::envelope,
+                     "Where the camera can be (CameraEnvelope); None: the map's camera_envelope when map_envelope and "
+                     "the map has one, else anywhere.")
+      .def_readwrite("map_envelope", &RelocalizerOptions::map_envelope,
+                     "Without `envelope`, keep the camera within the map's camera_envelope when it has one.")
       .def("validate", &RelocalizerOptions::validate, "'' when every field is in range, else the first that is not.");
 }
 

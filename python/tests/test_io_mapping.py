@@ -154,6 +154,31 @@ def test_box_mapping_of_real_frames_equals_the_command_line(data_dir, cli, tmp_p
     assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
 
 
+def test_a_mapped_map_keeps_the_relocalizer_where_it_was_made(data_dir, tmp_path):
+    d = data_dir / "tum_fr3_office_first_half"
+    camera, truth = E.read_camera(d / "camera.yaml"), E.read_trajectory(d / "groundtruth.txt")
+    mapper = E.Mapper(camera, mode=E.MappingMode.boxes)
+    stamps = [E.find_nearest(truth, f.timestamp) for f in E.read_detections(d / "detections.json")[:200:10]]
+    poses = [truth[k].pose for k in stamps if k is not None]
+    assert len(poses) > 10
+    for pose in poses:
+        mapper.add_keyframe(pose, [])
+    envelope = mapper.map().camera_envelope
+    assert isinstance(envelope, E.CameraEnvelope) and all(envelope.admits(p) for p in poses)
+    heights = [float(np.dot(envelope.up, p.center)) for p in poses]
+    assert envelope.min_height == pytest.approx(min(heights) - 1.0) and list(envelope.up) == [0, 0, 1]
+    E.write_map(tmp_path / "map.json", E.ObjectMap([E.MapObject(1, 41, E.Ellipsoid([0, 0, 1], [0.1, 0.1, 0.1]))]))
+    assert E.read_map(tmp_path / "map.json").camera_envelope is None
+    world = E.ObjectMap([E.MapObject(1, 41, E.Ellipsoid([0, 0, 1], [0.1, 0.1, 0.1]))])
+    world.camera_envelope = envelope
+    E.write_map(tmp_path / "map.json", world)
+    back = E.read_map(tmp_path / "map.json").camera_envelope
+    assert (back.min_height, back.max_tilt_deg) == (envelope.min_height, envelope.max_tilt_deg)
+    assert E.ObjectRelocalizer(world, camera).options.envelope.max_height == envelope.max_height
+    assert E.ObjectRelocalizer(world, camera, map_envelope=False).options.envelope is None
+    assert E.ObjectRelocalizer(world, camera, method="oa-slam").options.envelope is None
+
+
 def test_mapper_refuses_bad_keyframes(office):
     _, camera, _ = office
     mapper = E.Mapper(camera)

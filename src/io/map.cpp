@@ -1,5 +1,6 @@
 #include "ellreloc/io/map.hpp"
 
+#include <cmath>
 #include <cstdlib>
 #include <sstream>
 
@@ -48,6 +49,23 @@ Ellipsoid parseObjectGeometry(const json& obj, const Where& where) {
   for (size_t i = 0; i < 16; ++i)
     Q(static_cast<int>(i / 4), static_cast<int>(i % 4)) = detail::finiteNumber(q[i], where["dual_quadric"][i]);
   return ellipsoidFromDualQuadric(Q, where["dual_quadric"].path);
+}
+
+/// {"up": [x, y, z], "height": [min, max], "tilt_deg": [min, max]}: the heights (metres along
+/// the unit `up`) and tilts of the map's keyframes (CameraEnvelope).
+CameraEnvelope parseEnvelope(const json& e, const Where& where) {
+  CameraEnvelope envelope;
+  const Eigen::Vector3d up = detail::vector<3>(detail::member(e, "up", where), where["up"]);
+  if (!(std::abs(up.norm() - 1.0) < 1e-6)) where["up"].fail("expected a unit vector");
+  envelope.up = up;
+  const Eigen::Vector2d height = detail::vector<2>(detail::member(e, "height", where), where["height"]);
+  const Eigen::Vector2d tilt = detail::vector<2>(detail::member(e, "tilt_deg", where), where["tilt_deg"]);
+  if (!(height(0) <= height(1))) where["height"].fail("expected [min, max] with min <= max");
+  if (!(tilt(0) >= 0.0 && tilt(0) <= tilt(1) && tilt(1) <= 180.0))
+    where["tilt_deg"].fail("expected [min, max] with 0 <= min <= max <= 180 degrees");
+  envelope.min_height = height(0), envelope.max_height = height(1);
+  envelope.min_tilt_deg = tilt(0), envelope.max_tilt_deg = tilt(1);
+  return envelope;
 }
 
 /// Keeps `object` or, when unusable, leaves it out with a warning naming it.
@@ -124,6 +142,7 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source, std::
     map.points.reserve(points.size());
     for (size_t i = 0; i < points.size(); ++i) map.points.push_back(detail::vector<3>(points[i], top["points"][i]));
   }
+  if (j.contains("camera_envelope")) map.camera_envelope = parseEnvelope(j["camera_envelope"], top["camera_envelope"]);
   return map;
 }
 
@@ -189,6 +208,12 @@ void writeMap(const std::string& path, const ObjectMap& map) {
     json points = json::array();
     for (const auto& p : map.points) points.push_back({p(0), p(1), p(2)});
     j["points"] = std::move(points);
+  }
+  if (const auto& e = map.camera_envelope) {
+    if (!e->isValid()) throw Error(path + ": the camera envelope is not valid (unit up, min <= max)");
+    j["camera_envelope"] = {{"up", {e->up(0), e->up(1), e->up(2)}},
+                            {"height", {e->min_height, e->max_height}},
+                            {"tilt_deg", {e->min_tilt_deg, e->max_tilt_deg}}};
   }
   writeFileAtomically(path, j.dump(1) + "\n");
 }

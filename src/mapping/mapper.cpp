@@ -128,6 +128,7 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
   std::unique_lock lock(mutex_);
   checkKeyframe(pose, detections, depth);
   KeyframeReport report;
+  keyframe_poses_.push_back(pose);
   if (options_.mode == MappingMode::Voxel && options_.estimate_up_from_floor) {
     FloorOptions floor = options_.floor;
     floor.prior_up = options_.ellipsoid.up;
@@ -391,11 +392,19 @@ void Mapper::mergeDuplicateBoxTracks() {
   }
 }
 
+Eigen::Vector3d Mapper::upLocked() const {
+  return floor_normal_sum_.norm() > 0.0 ? floor_normal_sum_.normalized() : options_.ellipsoid.up.normalized();
+}
+
 ObjectMap Mapper::map() const {
   std::shared_lock lock(mutex_);
   ObjectMap out;
   for (const Track& t : tracks_)
     if (t.confirmed && t.built) out.objects.push_back(t.built->object);
+  // Where the keyframes were taken, measured along the up the ellipsoids stand on. The
+  // relocalizer keeps to it by default, so it is wider than the usual envelope (0.5 m, 20
+  // degrees): a camera may come back lower, higher or more tilted than it mapped from.
+  out.camera_envelope = CameraEnvelope::fromKeyframes(keyframe_poses_, upLocked(), 1.0, 30.0);
   return out;
 }
 
@@ -411,7 +420,7 @@ MapperStats Mapper::stats() const {
   std::shared_lock lock(mutex_);
   MapperStats s;
   s.keyframes = keyframes_;
-  s.up = floor_normal_sum_.norm() > 0.0 ? floor_normal_sum_.normalized() : options_.ellipsoid.up.normalized();
+  s.up = upLocked();
   for (const Track& t : tracks_) {
     (t.confirmed && t.built ? s.objects : s.candidates) += 1;
     s.voxels += t.voxels.size();

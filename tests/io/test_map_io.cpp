@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -61,6 +62,29 @@ TEST(MapIo, JsonRoundTripAndDualQuadricForm) {
   const ObjectMap from_q = io::parseMapJson(j.dump(), "inline");
   for (size_t i = 0; i < map.objects.size(); ++i)
     EXPECT_LT((from_q.objects[i].ellipsoid.shapeMatrix() - map.objects[i].ellipsoid.shapeMatrix()).norm(), 1e-12);
+  EXPECT_FALSE(back.camera_envelope);  // none written, none read
+}
+
+TEST(MapIo, TheCameraEnvelopeRoundTrips) {
+  std::mt19937 rng(42);
+  ObjectMap map;
+  map.objects.push_back({1, 41, "cup", test::randomEllipsoid(rng)});
+  CameraEnvelope e;
+  e.up = Eigen::Vector3d(0.0, 0.6, 0.8);
+  e.min_height = 0.25, e.max_height = 2.5, e.min_tilt_deg = 3.0, e.max_tilt_deg = 61.5;
+  map.camera_envelope = e;
+  test::TempDir dir;
+  io::writeMap(dir.path("map.json"), map);
+  const ObjectMap back = io::readMap(dir.path("map.json"));
+  ASSERT_TRUE(back.camera_envelope);
+  EXPECT_EQ(back.camera_envelope->up, e.up);
+  EXPECT_EQ(back.camera_envelope->min_height, 0.25);
+  EXPECT_EQ(back.camera_envelope->max_height, 2.5);
+  EXPECT_EQ(back.camera_envelope->min_tilt_deg, 3.0);
+  EXPECT_EQ(back.camera_envelope->max_tilt_deg, 61.5);
+  map.camera_envelope->max_height = 0.0;  // below min: not written, no file left
+  EXPECT_THROW(io::writeMap(dir.path("bad.json"), map), Error);
+  EXPECT_FALSE(std::ifstream(dir.path("bad.json")).good());
 }
 
 TEST(MapIo, ReadsOaSlamTextMaps) {
@@ -93,8 +117,18 @@ TEST(MapIo, MalformedMapsNameTheFileAndField) {
   struct Case {
     std::string content, expected;
   };
+  const std::string envelope_map = "{\"objects\": [" + obj + "], \"camera_envelope\": ";
   const std::vector<Case> cases = {
       {"", "empty file"},
+      {envelope_map + "[]}", "camera_envelope: expected an object"},
+      {envelope_map + R"({"height": [0, 1], "tilt_deg": [0, 30]}})", "camera_envelope.up: missing"},
+      {envelope_map + R"({"up": [0, 0, 2], "height": [0, 1], "tilt_deg": [0, 30]}})",
+       "camera_envelope.up: expected a unit vector"},
+      {envelope_map + R"({"up": [0, 0, 1], "height": [1, 0], "tilt_deg": [0, 30]}})",
+       "camera_envelope.height: expected [min, max]"},
+      {envelope_map + R"({"up": [0, 0, 1], "height": [0, 1], "tilt_deg": [0, 190]}})",
+       "camera_envelope.tilt_deg: expected [min, max] with 0 <= min"},
+      {envelope_map + R"({"up": [0, 0, 1], "height": [0, "x"], "tilt_deg": [0, 30]}})", "camera_envelope.height"},
       {"{\"objects\": [" + obj.substr(0, 40), "invalid JSON"},
       {"{\"ellreloc_map\": 1}", "objects: missing"},
       {"{\"objects\": {}}", "objects: expected an array"},

@@ -181,6 +181,33 @@ TEST(Mapper, BoxesOnlyMode) {
   EXPECT_GE(found, expected - 1);
 }
 
+// The map records where its keyframes were taken: their heights and tilts along the up the
+// ellipsoids stand on, widened by 1 m and 30 degrees; none before two keyframes.
+TEST(Mapper, TheMapRecordsTheKeyframesCameraEnvelope) {
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 4, 12, sim::NoiseModel{});
+  MapperOptions opt;
+  opt.mode = MappingMode::Boxes;
+  Mapper mapper(seq.K, opt);
+  EXPECT_FALSE(mapper.map().camera_envelope);
+  double low = 1e9, high = -1e9, least_tilt = 1e9, most_tilt = -1e9;
+  for (const auto& kf : seq.keyframes) {
+    mapper.addKeyframe(kf.pose, kf.detections);
+    const double height = kf.pose.center().z();
+    // The tilt: angle between the image's up (-y of the camera) and the world's z.
+    const double tilt = std::acos(-kf.pose.rotation().row(1).z()) * 180.0 / M_PI;
+    low = std::min(low, height), high = std::max(high, height);
+    least_tilt = std::min(least_tilt, tilt), most_tilt = std::max(most_tilt, tilt);
+  }
+  const std::optional<CameraEnvelope> e = mapper.map().camera_envelope;
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->up, Eigen::Vector3d::UnitZ());
+  EXPECT_NEAR(e->min_height, low - 1.0, 1e-9);
+  EXPECT_NEAR(e->max_height, high + 1.0, 1e-9);
+  EXPECT_NEAR(e->min_tilt_deg, std::max(0.0, least_tilt - 30.0), 1e-6);
+  EXPECT_NEAR(e->max_tilt_deg, std::min(180.0, most_tilt + 30.0), 1e-6);
+  for (const auto& kf : seq.keyframes) EXPECT_TRUE(e->admits(kf.pose));
+}
+
 TEST(Mapper, BadKeyframesAreErrorsAndLeaveTheMapUnchanged) {
   const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 1, 3, sim::NoiseModel());
   Mapper mapper(seq.K);

@@ -597,3 +597,32 @@ TEST(ObjectRelocalizer, EnvelopeGatesPoses) {
   EXPECT_EQ(ObjectRelocalizer(s.map, test::testIntrinsics(), options).relocalize(s.observations).status,
             RelocalizationStatus::InvalidInput);
 }
+
+// A map that records where it was made keeps the camera there unless the options give an
+// envelope of their own or turn the map's off; the OA-SLAM preset ignores it.
+TEST(ObjectRelocalizer, TheMapsEnvelopeGatesPosesByDefault) {
+  std::mt19937 rng(12);
+  Synthetic s = makeSceneSeeing(rng, 6, 12, 6);
+  const auto around_truth = CameraEnvelope::fromKeyframes({s.truth, s.truth}, Eigen::Vector3d::UnitZ(), 0.2, 5.0);
+  ASSERT_TRUE(around_truth);
+  CameraEnvelope above = *around_truth;  // the true camera is 0.8 m below it
+  above.min_height += 1.0, above.max_height += 1.0;
+  s.map.camera_envelope = above;
+  const auto relocalize = [&](const RelocalizerOptions& options) {
+    return ObjectRelocalizer(s.map, test::testIntrinsics(), options).relocalize(s.observations);
+  };
+  const auto found = [&](const RelocalizationResult& r) {
+    return r.status == RelocalizationStatus::Success && positionError(r.pose, s.truth) < 0.05;
+  };
+  RelocalizerOptions options;
+  EXPECT_FALSE(found(relocalize(options)));
+  EXPECT_EQ(ObjectRelocalizer(s.map, test::testIntrinsics(), options).options().envelope->min_height, above.min_height);
+  options.map_envelope = false;
+  EXPECT_TRUE(found(relocalize(options)));
+  options.map_envelope = true;
+  options.envelope = around_truth;  // the options' own envelope wins
+  EXPECT_TRUE(found(relocalize(options)));
+  s.map.camera_envelope = *around_truth;
+  EXPECT_TRUE(found(relocalize(RelocalizerOptions{})));
+  EXPECT_FALSE(RelocalizerOptions::oaSlam().map_envelope);
+}

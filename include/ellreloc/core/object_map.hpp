@@ -5,9 +5,11 @@
 #include <Eigen/Core>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "ellreloc/core/camera_envelope.hpp"
 #include "ellreloc/core/ellipsoid.hpp"
 
 namespace ellreloc {
@@ -37,6 +39,9 @@ struct MapObject {
 struct ObjectMap {
   std::vector<MapObject> objects;
   std::vector<Eigen::Vector3d> points;  ///< optional map points, indexed by keypoint matches
+  /// Optional: the heights and tilts the map's keyframes were taken at (widened); the
+  /// relocalizer keeps the camera within them (RelocalizerOptions::map_envelope).
+  std::optional<CameraEnvelope> camera_envelope;
 };
 
 /// Semi-axes outside [kMinSemiAxis, kMaxSemiAxis] metres make an object unusable: a

@@ -108,7 +108,9 @@ class Mapper {
   /// nothing.
   void finish();
 
-  /// The objects in the map (those with an ellipsoid), in the order they were created.
+  /// The objects in the map (those with an ellipsoid), in the order they were created, and
+  /// the camera envelope of the keyframes (heights and tilts along stats().up, widened by 1 m
+  /// and 30 degrees; none before two keyframes).
   ObjectMap map() const;
   std::vector<MappedObject> objects() const;
   MapperStats stats() const;
@@ -140,12 +142,15 @@ class Mapper {
   void mergeDuplicateBoxTracks();
   void mergeDuplicateVoxelTracks();
   void rebuild(Track& track) const;
+  /// The world's up: the floor's normal when estimated, else the options' (mutex_ held).
+  Eigen::Vector3d upLocked() const;
 
   Intrinsics K_;
   MapperOptions options_;
   mutable std::shared_mutex mutex_;
   std::vector<Track> tracks_;
   int keyframes_ = 0;
+  std::vector<Pose> keyframe_poses_;  // for the map's camera envelope
   int next_id_ = 0;
   Eigen::Vector3d floor_normal_sum_ = Eigen::Vector3d::Zero();
 };

@@ -112,6 +112,7 @@ class ObjectRelocalizer {
   /// "object ID: WHY" for each object of the map that is never matched.
   const std::vector<std::string>& leftOut() const { return left_out_; }
   const Intrinsics& intrinsics() const { return K_; }
+  /// The options in use: `envelope` is the map's camera_envelope when it came from there.
   const RelocalizerOptions& options() const { return options_; }
 
  private:

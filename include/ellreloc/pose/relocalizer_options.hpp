@@ -13,8 +13,8 @@
 #include <optional>
 #include <string>
 
+#include "ellreloc/core/camera_envelope.hpp"
 #include "ellreloc/core/ransac.hpp"
-#include "ellreloc/pose/camera_envelope.hpp"
 #include "ellreloc/pose/few_object_poses.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
@@ -142,8 +142,12 @@ struct RelocalizerOptions {
   RefinementStageOptions refinement;
   AcceptanceOptions acceptance;
   /// Where the camera can be (camera_envelope.hpp, e.g. from the mapping keyframes): poses
-  /// outside are never hypotheses. None: anywhere.
+  /// outside are never hypotheses. None: the map's own (ObjectMap::camera_envelope) when
+  /// `map_envelope` and the map has one, else anywhere.
   std::optional<CameraEnvelope> envelope;
+  /// Without `envelope`, keep the camera within the map's camera_envelope when it has one
+  /// (maps built by the Mapper record where their keyframes were taken).
+  bool map_envelope = true;
 
   /// OA-SLAM's relocalization as a baseline: every detection triplet against every object
   /// triplet of equal categories, P3P on box centres, box-IoU scoring, no refinement. Give it
@@ -166,6 +170,7 @@ struct RelocalizerOptions {
     o.refinement.enabled = false;
     o.refinement.top_k = 1;
     o.acceptance.enabled = false;  // OA-SLAM reports every pose it finds
+    o.map_envelope = false;        // nor does it keep the camera where the map was made
     return o;
   }
 
