@@ -401,10 +401,13 @@ ObjectMap Mapper::map() const {
   ObjectMap out;
   for (const Track& t : tracks_)
     if (t.confirmed && t.built) out.objects.push_back(t.built->object);
-  // Where the keyframes were taken, measured along the up the ellipsoids stand on. The
-  // relocalizer keeps to it by default, so it is wider than the usual envelope (0.5 m, 20
-  // degrees): a camera may come back lower, higher or more tilted than it mapped from.
-  out.camera_envelope = CameraEnvelope::fromKeyframes(keyframe_poses_, upLocked(), 1.0, 30.0);
+  // Where the keyframes were taken, measured along the up the ellipsoids stand on (voxel mode,
+  // or boxes mode given one), else along the keyframes' mean image-up, whatever the world
+  // frame's convention. The relocalizer keeps to it by default, so it is wider than the usual
+  // envelope (0.5 m, 20 degrees): a camera may come back lower, higher or more tilted.
+  const std::optional<Eigen::Vector3d> up =
+      options_.mode == MappingMode::Voxel ? std::optional<Eigen::Vector3d>(upLocked()) : options_.boxes.up;
+  out.camera_envelope = CameraEnvelope::fromKeyframes(keyframe_poses_, up, 1.0, 30.0);
   return out;
 }
 

@@ -181,31 +181,37 @@ TEST(Mapper, BoxesOnlyMode) {
   EXPECT_GE(found, expected - 1);
 }
 
-// The map records where its keyframes were taken: their heights and tilts along the up the
-// ellipsoids stand on, widened by 1 m and 30 degrees; none before two keyframes.
+// The map records where its keyframes were taken: their heights and tilts along the world's up
+// when the mapper has one (voxel mode, or boxes mode given `boxes.up`), else along their mean
+// image-up, widened by 1 m and 30 degrees; none before two keyframes.
 TEST(Mapper, TheMapRecordsTheKeyframesCameraEnvelope) {
   const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 4, 12, sim::NoiseModel{});
-  MapperOptions opt;
-  opt.mode = MappingMode::Boxes;
-  Mapper mapper(seq.K, opt);
-  EXPECT_FALSE(mapper.map().camera_envelope);
-  double low = 1e9, high = -1e9, least_tilt = 1e9, most_tilt = -1e9;
-  for (const auto& kf : seq.keyframes) {
-    mapper.addKeyframe(kf.pose, kf.detections);
-    const double height = kf.pose.center().z();
-    // The tilt: angle between the image's up (-y of the camera) and the world's z.
-    const double tilt = std::acos(-kf.pose.rotation().row(1).z()) * 180.0 / M_PI;
-    low = std::min(low, height), high = std::max(high, height);
-    least_tilt = std::min(least_tilt, tilt), most_tilt = std::max(most_tilt, tilt);
+  Eigen::Vector3d mean_image_up = Eigen::Vector3d::Zero();
+  for (const auto& kf : seq.keyframes) mean_image_up -= kf.pose.rotation().row(1).transpose();  // camera -y
+  for (const bool given_up : {true, false}) {
+    MapperOptions opt;
+    opt.mode = MappingMode::Boxes;
+    if (given_up) opt.boxes.up = Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d up = given_up ? Eigen::Vector3d::UnitZ() : mean_image_up.normalized();
+    Mapper mapper(seq.K, opt);
+    EXPECT_FALSE(mapper.map().camera_envelope);
+    double low = 1e9, high = -1e9, least_tilt = 1e9, most_tilt = -1e9;
+    for (const auto& kf : seq.keyframes) {
+      mapper.addKeyframe(kf.pose, kf.detections);
+      const double height = up.dot(kf.pose.center());
+      const double tilt = std::acos(-kf.pose.rotation().row(1).dot(up)) * 180.0 / M_PI;
+      low = std::min(low, height), high = std::max(high, height);
+      least_tilt = std::min(least_tilt, tilt), most_tilt = std::max(most_tilt, tilt);
+    }
+    const std::optional<CameraEnvelope> e = mapper.map().camera_envelope;
+    ASSERT_TRUE(e);
+    EXPECT_LT((e->up - up).norm(), 1e-12) << given_up;
+    EXPECT_NEAR(e->min_height, low - 1.0, 1e-9);
+    EXPECT_NEAR(e->max_height, high + 1.0, 1e-9);
+    EXPECT_NEAR(e->min_tilt_deg, std::max(0.0, least_tilt - 30.0), 1e-6);
+    EXPECT_NEAR(e->max_tilt_deg, std::min(180.0, most_tilt + 30.0), 1e-6);
+    for (const auto& kf : seq.keyframes) EXPECT_TRUE(e->admits(kf.pose));
   }
-  const std::optional<CameraEnvelope> e = mapper.map().camera_envelope;
-  ASSERT_TRUE(e);
-  EXPECT_EQ(e->up, Eigen::Vector3d::UnitZ());
-  EXPECT_NEAR(e->min_height, low - 1.0, 1e-9);
-  EXPECT_NEAR(e->max_height, high + 1.0, 1e-9);
-  EXPECT_NEAR(e->min_tilt_deg, std::max(0.0, least_tilt - 30.0), 1e-6);
-  EXPECT_NEAR(e->max_tilt_deg, std::min(180.0, most_tilt + 30.0), 1e-6);
-  for (const auto& kf : seq.keyframes) EXPECT_TRUE(e->admits(kf.pose));
 }
 
 TEST(Mapper, BadKeyframesAreErrorsAndLeaveTheMapUnchanged) {

@@ -109,8 +109,9 @@ class Mapper {
   void finish();
 
   /// The objects in the map (those with an ellipsoid), in the order they were created, and
-  /// the camera envelope of the keyframes (heights and tilts along stats().up, widened by 1 m
-  /// and 30 degrees; none before two keyframes).
+  /// the camera envelope of the keyframes (heights and tilts along the world's up in voxel
+  /// mode or with boxes.up, else along their mean image-up; widened by 1 m and 30 degrees;
+  /// none before two keyframes).
   ObjectMap map() const;
   std::vector<MappedObject> objects() const;
   MapperStats stats() const;
