@@ -72,6 +72,19 @@ TEST(Ellipse, AngleFromAGaussianIsHalfTheAtan2OfItsCovariance) {
   }
 }
 
+// Covariances at any finite scale: the angle neither underflows nor overflows (a fuzzer found
+// conics of 1e-170 px^2 whose axis direction vanished when squared).
+TEST(Ellipse, AngleFromGaussiansOfExtremeScale) {
+  for (const double scale : {1e-300, 1e-170, 1e-100, 1.0, 1e100, 1e150}) {
+    const Eigen::Matrix2d S = scale * (Eigen::Matrix2d() << 9.0, 2.0, 2.0, 4.0).finished();
+    const auto e = Ellipse::fromGaussian(Eigen::Vector2d(1.0, 2.0), S);
+    ASSERT_TRUE(e.has_value()) << scale;
+    EXPECT_TRUE(e->isValid()) << scale;
+    EXPECT_NEAR(e->angle(), 0.5 * std::atan2(4.0, 5.0), 1e-12) << scale;
+    EXPECT_NEAR(e->rotation().determinant(), 1.0, 1e-12) << scale;
+  }
+}
+
 TEST(Ellipse, PrimalConicVanishesOnTheBoundaryAndIsTheInverseOfTheDual) {
   std::mt19937 rng(3);
   for (int i = 0; i < 300; ++i) {

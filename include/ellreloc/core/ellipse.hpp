@@ -8,6 +8,7 @@
 /// H = [R c; 0 1], i.e. normalised so that C*(2,2) = -1.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -85,7 +86,7 @@ class Ellipse {
     const double p = cov(0, 0), r = cov(1, 1), q = 0.5 * (cov(0, 1) + cov(1, 0));
     // Closed-form eigen decomposition of a symmetric 2x2 matrix.
     const double half_trace = 0.5 * (p + r), half_diff = 0.5 * (p - r);
-    const double radius = std::sqrt(half_diff * half_diff + q * q);
+    const double radius = scaledNorm(half_diff, q);
     const double l1 = half_trace + radius, l2 = half_trace - radius;
     if (!(l2 > 0.0) || !(l2 > 1e-12 * l1)) return std::nullopt;
     // Axis a is the eigenvector of l1: (l1 - r, q) = (half_diff + radius, q), or (q, l1 - p) =
@@ -98,7 +99,7 @@ class Ellipse {
     } else if (half_diff < 0.0) {
       c = q < 0.0 ? -q : q, s = q < 0.0 ? half_diff - radius : radius - half_diff;
     }
-    const double norm = std::sqrt(c * c + s * s);
+    const double norm = scaledNorm(c, s);
     return Ellipse(mean, Eigen::Vector2d(std::sqrt(l1), std::sqrt(l2)), c / norm, s / norm);
   }
 
@@ -184,6 +185,14 @@ class Ellipse {
   }
 
  private:
+  /// sqrt(x^2 + y^2) without overflow or underflow at any finite scale (as std::hypot, cheaper).
+  static double scaledNorm(double x, double y) {
+    const double m = std::max(std::abs(x), std::abs(y));
+    if (!(m > 0.0)) return 0.0;
+    const double u = x / m, v = y / m;
+    return m * std::sqrt(u * u + v * v);
+  }
+
   /// From the cosine and sine of the angle (a unit vector); the angle is computed when asked.
   Ellipse(const Eigen::Vector2d& center, const Eigen::Vector2d& axes, double cos_angle, double sin_angle)
       : center_(center),
