@@ -221,6 +221,7 @@ inline double ellipseIoU(const Ellipse& e1, const Ellipse& e2, int vertices = 12
 inline double ellipseIoUUpperBound(const Ellipse& e1, const Ellipse& e2, int vertices = 128) {
   if (!e1.isValid() || !e2.isValid() || vertices < 3) return 0.0;
   const double a1 = e1.area(), a2 = e2.area();
+  if (!std::isfinite(a1 + a2)) return 1.0;  // areas beyond a double: no bound
   const Ellipse& small = a1 < a2 ? e1 : e2;
   const Ellipse& big = a1 < a2 ? e2 : e1;
   const double k = detail::polygonConstants(vertices).k;
@@ -243,6 +244,7 @@ inline double ellipseIoUUpperBound(const Ellipse& e1, const Ellipse& e2, int ver
 inline double ellipseIoULowerBound(const Ellipse& e1, const Ellipse& e2, int vertices = 128) {
   if (!e1.isValid() || !e2.isValid() || vertices < 3) return 0.0;
   const double a1 = e1.area(), a2 = e2.area();
+  if (!std::isfinite(a1 + a2)) return 0.0;  // areas beyond a double: no bound
   const Ellipse& small = a1 < a2 ? e1 : e2;
   const Ellipse& big = a1 < a2 ? e2 : e1;
   const Eigen::Matrix2d to_disc = big.axes().cwiseInverse().asDiagonal() * big.rotation().transpose();
@@ -257,6 +259,7 @@ inline double ellipseIoULowerBound(const Ellipse& e1, const Ellipse& e2, int ver
   const double r1 = std::sqrt(0.5 * (f + root)), r2 = d / std::max(r1, 1e-300);
   const double inter = std::min(M_PI * std::min(r1, 1.0 - rho) * std::min(r2, 1.0 - rho) * big.axes().prod(),
                                 small.area());
+  if (!(inter > 0.0)) return 0.0;  // also 0 * inf at absurd scales: no bound then
   return inter / (a1 + a2 - inter);
 }
 
