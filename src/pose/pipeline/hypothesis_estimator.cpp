@@ -38,12 +38,12 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
     own->ellipses[k] = p.ellipse;
     own->count = k + 1;
   }
-  for (int k = 0; k < count && check_overlap; ++k)
-    if (!scorer_.overlapCertainlyReaches(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k],
-                                         kRankingIoUVertices, min_overlap) &&
-        scorer_.overlap(observations_[pairs_[pair_indices[k]].observation], own->ellipses[k], kRankingIoUVertices) <
-            min_overlap)
+  for (int k = 0; k < count && check_overlap; ++k) {
+    const Observation& o = observations_[pairs_[pair_indices[k]].observation];
+    if (!scorer_.overlapCertainlyReaches(o, own->ellipses[k], kRankingIoUVertices, min_overlap) &&
+        scorer_.overlap(o, own->ellipses[k], kRankingIoUVertices) < min_overlap)
       return false;
+  }
   return true;
 }
 
