@@ -146,6 +146,25 @@ bool fitEllipsoid(const Intrinsics& K, const std::vector<BoxView>& views, const 
   return true;
 }
 
+/// Where the object stands when its rays barely diverge: on each view's ray through the box
+/// centre, at the depth where an object of the category's typical size fills the box; the
+/// mean over the views (the fit then weighs the little parallax there is against the prior).
+std::optional<Eigen::Vector3d> centreAtTypicalSize(const Intrinsics& K, const std::vector<BoxView>& views,
+                                                   const BoxSizePrior& prior) {
+  const double typical_radius = prior.typical_semi_axes.mean();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const BoxView& v : views) {
+    const Eigen::Vector3d b = K.bearing(Eigen::Vector2d(0.5 * (v.box.x1 + v.box.x2), 0.5 * (v.box.y1 + v.box.y2)));
+    const double radius_per_depth = 0.25 * (v.box.width() / K.fx + v.box.height() / K.fy);
+    if (!(b.z() > 0.0) || !(radius_per_depth > 0.0)) return std::nullopt;
+    const double depth = typical_radius / radius_per_depth;
+    sum += v.pose.center() + v.pose.rotation().transpose() * (b / b.z() * depth);
+  }
+  const Eigen::Vector3d centre = sum / static_cast<double>(views.size());
+  if (!centre.allFinite()) return std::nullopt;
+  return centre;
+}
+
 }  // namespace
 
 const char* toString(BoxEllipsoidStatus status) {
@@ -215,8 +234,10 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
   for (size_t i = 0; i < rays.size(); ++i)
     for (size_t j = i + 1; j < rays.size(); ++j) min_cos = std::min(min_cos, rays[i].dot(rays[j]));
   out.baseline_deg = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 180.0 / M_PI;
-  const auto centre = triangulateBoxCentres(K, views);
-  if (out.baseline_deg < options.min_baseline_deg || !centre) {
+  const bool narrow = out.baseline_deg < options.min_baseline_deg;
+  std::optional<Eigen::Vector3d> centre = narrow ? std::nullopt : triangulateBoxCentres(K, views);
+  if (!centre && options.use_size_prior) centre = centreAtTypicalSize(K, views, prior);
+  if (!centre) {
     out.status = BoxEllipsoidStatus::NoBaseline;
     out.reason = "rays span " + std::to_string(out.baseline_deg) + " deg";
     return out;

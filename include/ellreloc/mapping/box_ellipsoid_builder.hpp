@@ -2,8 +2,9 @@
 /// \file box_ellipsoid_builder.hpp
 /// Monocular object mapping from boxes: an ellipsoid from three or more detection boxes of one
 /// object seen from known camera poses (as OA-SLAM and QuadricSLAM users have them). The centre
-/// is triangulated from the rays through the box centres, the semi-axes start from the box
-/// sizes at that depth, and the 9-DoF ellipsoid (centre, semi-axes, rotation) is refined by
+/// is triangulated from the rays through the box centres (or, when the rays barely diverge,
+/// placed on them where the category's typical size fills the boxes), the semi-axes start from
+/// the box sizes at that depth, and the 9-DoF ellipsoid (centre, semi-axes, rotation) is refined by
 /// minimising the squared Wasserstein distance between each box-inscribed ellipse and the
 /// ellipsoid's projection (Ceres). A size prior keeps an axis the boxes leave unobserved (the
 /// depth of an object seen from one side) near its category's typical size, and bounds every
@@ -42,7 +43,9 @@ struct BoxSizePrior {
 
 struct BoxEllipsoidOptions {
   size_t min_views = 3;
-  /// The rays to the object must span at least this angle, else depth is unobservable.
+  /// Below this angle between the rays to the object, triangulation cannot tell its depth: the
+  /// size prior then places it where the category's typical size fills the boxes (the fit
+  /// weighs what parallax there is against the prior); without the prior, NoBaseline.
   double min_baseline_deg = 5.0;
   /// Boxes within this many pixels of the image border cut the object; they are left out of
   /// the fit while at least min_views other views remain.
@@ -63,7 +66,7 @@ struct BoxEllipsoidOptions {
 enum class BoxEllipsoidStatus {
   Ok,
   TooFewViews,   ///< fewer than min_views valid views
-  NoBaseline,    ///< the viewing rays are nearly parallel
+  NoBaseline,    ///< the viewing rays are nearly parallel and no size prior places the object
   BehindCamera,  ///< the triangulated centre is behind a camera
   PoorFit,       ///< reprojection IoU below min_median_iou
   InvalidInput,  ///< invalid intrinsics, poses or boxes
