@@ -149,7 +149,7 @@ TEST(BoxEllipsoidBuilder, StatusesInsteadOfGuesses) {
   const Ellipsoid truth(Eigen::Vector3d(0.5, 1.0, 0.4), Eigen::Vector3d(0.3, 0.15, 0.2), Eigen::Matrix3d::Identity());
   EXPECT_EQ(buildEllipsoidFromBoxes(kK, ringViews(truth, 2, 2.0, 60.0)).status, BoxEllipsoidStatus::TooFewViews);
   BoxEllipsoidOptions no_prior;
-  no_prior.use_size_prior = false;  // with it, a narrow baseline still gives an object (below)
+  no_prior.use_size_prior = false;  // with it, a narrow baseline still gives an object (above)
   EXPECT_EQ(buildEllipsoidFromBoxes(kK, ringViews(truth, 5, 2.0, 1.0), no_prior).status,
             BoxEllipsoidStatus::NoBaseline);
   EXPECT_EQ(buildEllipsoidFromBoxes(Intrinsics(), ringViews(truth, 5, 2.0, 60.0)).status,
