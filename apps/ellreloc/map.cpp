@@ -61,8 +61,13 @@ void printSummary(const ObjectMap& map, const std::vector<std::string>& dropped,
             (name ? std::string(name) : "category " + std::to_string(category));
   }
   std::printf("  objects: %s\n", line.empty() ? "none" : line.c_str());
-  std::printf("  left out: %zu degenerate object(s)%s%s; %d candidate(s) seen fewer than %d times\n", dropped.size(),
-              dropped.empty() ? "" : ": ", joined(dropped).c_str(), stats.candidates, min_observations);
+  std::printf(
+      "  left out: %zu degenerate object(s)%s%s; %d candidate(s) seen fewer than %d times or fitting no ellipsoid\n",
+      dropped.size(), dropped.empty() ? "" : ": ", joined(dropped).c_str(), stats.candidates, min_observations);
+  if (stats.placed_by_size > 0)
+    std::printf(
+        "  %d object(s) placed by their category's typical size: seen over too narrow a baseline to triangulate\n",
+        stats.placed_by_size);
   if (const auto& e = map.camera_envelope)
     std::printf(
         "  camera envelope (relocalization keeps to it): heights %.2f to %.2f m along up (%.3f, %.3f, %.3f), "

@@ -276,6 +276,7 @@ class MapperStats:
     up: numpy.ndarray
     objects: int
     candidates: int
+    placed_by_size: int
     voxels: int
     memory_bytes: int
 

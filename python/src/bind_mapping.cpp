@@ -111,6 +111,7 @@ void bindMapperClass(py::module_& m) {
       .def_property_readonly("up", [](const MapperStats& s) { return toArray(s.up); })
       .def_readonly("objects", &MapperStats::objects)
       .def_readonly("candidates", &MapperStats::candidates)
+      .def_readonly("placed_by_size", &MapperStats::placed_by_size)
       .def_readonly("voxels", &MapperStats::voxels)
       .def_readonly("memory_bytes", &MapperStats::memory_bytes);
   py::class_<Mapper>(m, "Mapper",

@@ -236,7 +236,10 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
   out.baseline_deg = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 180.0 / M_PI;
   const bool narrow = out.baseline_deg < options.min_baseline_deg;
   std::optional<Eigen::Vector3d> centre = narrow ? std::nullopt : triangulateBoxCentres(K, views);
-  if (!centre && options.use_size_prior) centre = centreAtTypicalSize(K, views, prior);
+  if (!centre && options.use_size_prior) {
+    centre = centreAtTypicalSize(K, views, prior);
+    out.depth_from_size = centre.has_value();
+  }
   if (!centre) {
     out.status = BoxEllipsoidStatus::NoBaseline;
     out.reason = "rays span " + std::to_string(out.baseline_deg) + " deg";

@@ -193,6 +193,7 @@ void Mapper::rebuild(Track& track) const {
       return;
     }
     m.object.ellipsoid = r.ellipsoid;
+    m.depth_from_size = r.depth_from_size;
   }
   track.built = m;
 }
@@ -426,6 +427,7 @@ MapperStats Mapper::stats() const {
   s.up = upLocked();
   for (const Track& t : tracks_) {
     (t.confirmed && t.built ? s.objects : s.candidates) += 1;
+    if (t.confirmed && t.built && t.built->depth_from_size) ++s.placed_by_size;
     s.voxels += t.voxels.size();
     s.memory_bytes += t.voxels.memoryBytes();
   }

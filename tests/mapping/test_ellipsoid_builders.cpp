@@ -117,6 +117,7 @@ TEST(BoxEllipsoidBuilder, RecoversAnEllipsoidFromItsBoxes) {
   EXPECT_NEAR(r.ellipsoid.volume(), truth.volume(), 0.25 * truth.volume());
   EXPECT_EQ(r.views_used, 10);
   EXPECT_GT(r.baseline_deg, 100.0);
+  EXPECT_FALSE(r.depth_from_size);  // triangulated
 }
 
 // Rays that barely diverge (a camera that slid 4 cm) leave the depth to the size prior: the
@@ -136,6 +137,7 @@ TEST(BoxEllipsoidBuilder, ANarrowBaselinePlacesTheObjectByItsTypicalSize) {
     const BoxEllipsoidResult r = buildEllipsoidFromBoxes(kK, views, {}, prior);
     ASSERT_TRUE(r.ok()) << r.reason;
     EXPECT_LT(r.baseline_deg, 5.0);
+    EXPECT_TRUE(r.depth_from_size);
     EXPECT_GT(r.median_iou, 0.8);
     const Eigen::Vector3d found = r.ellipsoid.center() - eye;
     depth[k] = found.dot(ray);

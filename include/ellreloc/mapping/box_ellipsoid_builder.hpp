@@ -79,7 +79,8 @@ struct BoxEllipsoidResult {
   double median_iou = 0.0;    ///< projected bounding box vs detection box, over the views used
   double baseline_deg = 0.0;  ///< largest angle between two viewing rays
   int views_used = 0;
-  std::string reason;  ///< why it failed, in a few words
+  bool depth_from_size = false;  ///< the rays spanned < min_baseline_deg: the size prior placed it
+  std::string reason;            ///< why it failed, in a few words
   bool ok() const { return status == BoxEllipsoidStatus::Ok; }
 };
 

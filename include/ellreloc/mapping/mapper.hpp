@@ -78,15 +78,17 @@ struct MappedObject {
   MapObject object;              ///< id, category, label histogram, ellipsoid
   std::optional<Cuboid> cuboid;  ///< voxel mode: the yaw-aligned cuboid the ellipsoid is inscribed in
   int observations = 0;
-  size_t voxels = 0;        ///< voxel mode: voxels held
-  size_t memory_bytes = 0;  ///< voxel mode: heap memory of its voxels
+  bool depth_from_size = false;  ///< boxes mode: placed by its category's typical size (narrow baseline)
+  size_t voxels = 0;             ///< voxel mode: voxels held
+  size_t memory_bytes = 0;       ///< voxel mode: heap memory of its voxels
 };
 
 struct MapperStats {
   int keyframes = 0;
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< the up direction the ellipsoids use
   int objects = 0;                                ///< in the map
-  int candidates = 0;                             ///< seen fewer than min_observations times
+  int candidates = 0;      ///< not in the map: seen fewer than min_observations times, or no ellipsoid fits them
+  int placed_by_size = 0;  ///< boxes mode: objects in the map whose depth the size prior gave
   size_t voxels = 0;
   size_t memory_bytes = 0;
 };
