@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""The "fr3 splits" table of docs/benchmarks.md: monocular maps (`ellreloc map --mode boxes`,
+motion-capture poses) of six splits of the fr3/long_office first half, each relocalized on
+frames it was not built from, ours and the OA-SLAM preset. One split's figures move by several
+points when a fit changes which detections the tracker joins; the mean over six is what a
+change to the mapper is judged on.
+
+  even/odd    map the even frames, query every 5th odd frame
+  thirds      map two frames in three, query every 5th of the others
+  50/50, 60/40, 70/30
+              map the first 50, 60 or 70% of the frames, query every 5th of the rest (the
+              camera moves on to views the map saw little of)
+  last 60%    map the last 60%, query every 5th frame of the first 40%
+
+Usage: scripts/fr3_splits.py [BUILD_DIR] [DATA_DIR]   (prints a Markdown table)
+"""
+import json
+import os
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from real_data import box_map, data, relocalize  # noqa: E402  (same arguments as real_data.py)
+
+
+def splits(frames):
+    n = len(frames)
+    cut = {p: int(p / 100 * n) for p in (40, 50, 60, 70)}
+    return [
+        ("even/odd", frames[0::2], frames[1::10]),
+        ("thirds", [f for i, f in enumerate(frames) if i % 3], frames[0::15]),
+        ("50/50", frames[:cut[50]], frames[cut[50]::5]),
+        ("60/40", frames[:cut[60]], frames[cut[60]::5]),
+        ("70/30", frames[:cut[70]], frames[cut[70]::5]),
+        ("last 60%", frames[cut[40]:], frames[:cut[40]:5]),
+    ]
+
+
+def main():
+    fr3 = os.path.join(data, "tum_fr3_office_first_half")
+    camera, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
+    frames = json.load(open(os.path.join(fr3, "detections.json")))
+    print("| split | map frames | query frames | map | ours | ours, every pose | oa-slam preset |")
+    print("|---|---|---|---|---|---|---|")
+    totals = [0.0, 0.0, 0.0, 0.0]
+    with tempfile.TemporaryDirectory() as work:
+        for k, (name, mapping, query) in enumerate(splits(frames)):
+            mapping_path, query_path = os.path.join(work, "%d.map_frames.json" % k), os.path.join(work, "%d.q.json" % k)
+            json.dump(mapping, open(mapping_path, "w"))
+            json.dump(query, open(query_path, "w"))
+            map_path, what = box_map(camera, groundtruth, mapping_path, query_path, work, str(k))
+            valid = [float(relocalize(camera, map_path, query_path, groundtruth, method, work, extra)["valid"])
+                     for method, extra in (("ours", ()), ("ours", ("--accept-all",)), ("oa-slam", ()))]
+            quality = float(what.split("IoU ")[1])
+            for i, v in enumerate([quality] + valid):
+                totals[i] += v
+            print("| %s | %d | %d | %s | %.1f%% | %.1f%% | %.1f%% |" % (name, len(mapping), len(query), what, *valid))
+    count = len(splits(frames))
+    print("| **mean** | | | held-out IoU %.2f | **%.1f%%** | **%.1f%%** | %.1f%% |" %
+          tuple(t / count for t in totals))
+
+
+if __name__ == "__main__":
+    main()
