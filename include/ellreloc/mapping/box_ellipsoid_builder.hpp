@@ -79,7 +79,7 @@ struct BoxEllipsoidResult {
   double median_iou = 0.0;    ///< projected bounding box vs detection box, over the views used
   double baseline_deg = 0.0;  ///< largest angle between two viewing rays
   int views_used = 0;
-  bool depth_from_size = false;  ///< the rays spanned < min_baseline_deg: the size prior placed it
+  bool depth_from_size = false;  ///< triangulation could not tell the depth: the size prior placed it
   std::string reason;            ///< why it failed, in a few words
   bool ok() const { return status == BoxEllipsoidStatus::Ok; }
 };
