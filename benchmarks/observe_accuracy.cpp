@@ -141,6 +141,7 @@ int main() {
     record("box-inscribed", Ellipse::inscribedInBox(moments->bounds));
     record("moments", fitMaskEllipse(rle, MaskFitMethod::Moments, &verdict));
     record("direct (outline)", fitMaskEllipse(rle, MaskFitMethod::Direct, &verdict));
+    record("hull", fitMaskEllipse(rle, MaskFitMethod::Hull, &verdict));
     if (verdict.quad_vertices == 4)
       record("quadrilateral", fitMaskEllipse(rle, MaskFitMethod::Quadrilateral, &verdict));
     Detection det;
@@ -150,11 +151,12 @@ int main() {
     if (paper.observation) record("default (paper policy)", paper.observation->ellipse);
   }
   std::printf(
-      "| masks | n | box-inscribed | moments | direct (outline) | quadrilateral | default (paper policy) "
-      "|\n|---|---|---|---|---|---|---|\n");
+      "| masks | n | box-inscribed | moments | direct (outline) | hull | quadrilateral | default (paper policy) "
+      "|\n|---|---|---|---|---|---|---|---|\n");
   for (const auto& [group, methods] : errors) {
     std::printf("| %s | %zu |", group.c_str(), methods.at("box-inscribed").size());
-    for (const char* m : {"box-inscribed", "moments", "direct (outline)", "quadrilateral", "default (paper policy)"}) {
+    for (const char* m :
+         {"box-inscribed", "moments", "direct (outline)", "hull", "quadrilateral", "default (paper policy)"}) {
       const auto it = methods.find(m);
       if (it == methods.end())
         std::printf(" - |");

@@ -8,8 +8,9 @@
 //   3. the voxel mapper (all mapping keyframes) against the true objects (expected: seen in >= 3 of them);
 //   4. relocalization of the query frames with the perturbed map, the exact map and the voxel
 //      map of table 3 (observations to map to pose, all from the scene's files): ours (with
-//      and without the acceptance test), ours with box observations, the OA-SLAM preset, and
-//      ours refined from the true pose (what the observations and the map allow at best).
+//      and without the acceptance test), ours with box observations and with the mask policy's
+//      (every mask fitted), the OA-SLAM preset, and ours refined from the true pose (what the
+//      observations and the map allow at best) with the default and the mask policy.
 // Run: build/benchmarks/scene_accuracy DIR [DIR...]
 #include <cstdio>
 #include <iterator>
@@ -150,8 +151,11 @@ void scoreRelocalization(const bench::SceneFolder& s, const ObjectMap& voxel_map
     relocalizeRow(s, map_name, *map, "ours", RelocalizerOptions(), ObservationPolicy::Paper, false);
     relocalizeRow(s, map_name, *map, "ours, every pose", every_pose, ObservationPolicy::Paper, false);
     relocalizeRow(s, map_name, *map, "ours, every pose, box ellipses", every_pose, ObservationPolicy::Bbox, false);
+    relocalizeRow(s, map_name, *map, "ours, every pose, mask policy", every_pose, ObservationPolicy::Mask, false);
     relocalizeRow(s, map_name, *map, "oa-slam preset", RelocalizerOptions::oaSlam(), ObservationPolicy::Bbox, false);
     relocalizeRow(s, map_name, *map, "ours refined from the true pose", every_pose, ObservationPolicy::Paper, true);
+    relocalizeRow(s, map_name, *map, "ours refined from the true pose, mask policy", every_pose, ObservationPolicy::Mask,
+                  true);
   }
 }
 

@@ -297,6 +297,7 @@ class MaskFitMethod:
     moments: MaskFitMethod
     direct: MaskFitMethod
     quadrilateral: MaskFitMethod
+    hull: MaskFitMethod
     name: str
     value: int
     def __init__(self, value: int) -> None: ...
@@ -505,6 +506,7 @@ class RegularVerdict:
     min_corner_angle_deg: float
     touches_border: bool
     corners: numpy.ndarray
+    hull: numpy.ndarray
     def __bool__(self) -> bool: ...
 
 

@@ -37,7 +37,8 @@ void bindOptions(py::module_& m) {
       .value("moments", MaskFitMethod::Moments, "same second moments as the mask")
       .value("direct", MaskFitMethod::Direct, "direct least squares on the outline")
       .value("quadrilateral", MaskFitMethod::Quadrilateral,
-             "regular masks: the projectively inscribed ellipse of the quadrilateral");
+             "regular masks: the projectively inscribed ellipse of the quadrilateral")
+      .value("hull", MaskFitMethod::Hull, "the image of the cuboid's inscribed ellipsoid, from the mask's convex hull");
   py::class_<RegularMaskOptions>(m, "RegularMaskOptions", "Thresholds of the regular-mask test (regular_mask.hpp).")
       .def(py::init<>())
       .def_readwrite("min_solidity", &RegularMaskOptions::min_solidity)
@@ -83,6 +84,9 @@ void bindResults(py::module_& m) {
                              [](const RegularVerdict& v) {
                                return rowsToArray<2>(std::vector<Eigen::Vector2d>(v.corners.begin(), v.corners.end()));
                              })
+      .def_property_readonly(
+          "hull", [](const RegularVerdict& v) { return rowsToArray<2>(v.hull); },
+          "the convex hull of the mask's pixel squares, an (n, 2) array clockwise on screen")
       .def("__bool__", [](const RegularVerdict& v) { return v.regular; });
 }
 

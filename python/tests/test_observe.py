@@ -80,6 +80,11 @@ def test_regular_and_irregular_masks():
     np.testing.assert_allclose(fit.center, [70.0, 60.0], atol=1e-6)
     np.testing.assert_allclose(fit.axes, [30.0, 30.0], rtol=0.02)
     assert E.fit_mask_ellipse(np.zeros((8, 8), bool)) is None
+    # The hull fit: a rectangle's hull is the rectangle, whose ellipse touches its sides.
+    np.testing.assert_allclose(np.sort(np.unique(verdict.hull[:, 0])), [39.5, 109.5], atol=1e-9)
+    hull_fit = E.fit_mask_ellipse(rect, E.MaskFitMethod.hull)
+    np.testing.assert_allclose(hull_fit.axes, [35.0, 25.0], atol=1e-6)
+    np.testing.assert_allclose(E.fit_mask_ellipse(disc(r=30.0), E.MaskFitMethod.hull).axes, [30.0, 30.0], rtol=0.03)
 
 
 def test_box_observations_and_policies():

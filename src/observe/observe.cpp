@@ -15,6 +15,8 @@ std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, MaskFitMethod method, 
     }
     case MaskFitMethod::Direct:
       return fitEllipseDirect(rleOutline(rle));
+    case MaskFitMethod::Hull:
+      return hullEllipse(verdict && !verdict->hull.empty() ? verdict->hull : rleConvexHull(rle));
     case MaskFitMethod::Quadrilateral:
       if (!verdict || verdict->quad_vertices != 4) return std::nullopt;
       return projectivelyInscribedEllipse(verdict->corners);

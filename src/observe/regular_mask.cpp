@@ -4,47 +4,16 @@
 #include <cmath>
 #include <limits>
 
+#include "polygon.hpp"
+
 namespace ellreloc {
 
 namespace {
 
-using Point = Eigen::Vector2d;
-
-double cross(const Point& o, const Point& a, const Point& b) {
-  return (a(0) - o(0)) * (b(1) - o(1)) - (a(1) - o(1)) * (b(0) - o(0));
-}
-
-double polygonArea(const std::vector<Point>& p) {
-  double a = 0.0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    const Point& u = p[i];
-    const Point& v = p[(i + 1) % p.size()];
-    a += u(0) * v(1) - u(1) * v(0);
-  }
-  return 0.5 * std::abs(a);
-}
-
-/// Reduces a convex polygon to `target` vertices by repeatedly dropping the vertex whose
-/// removal loses the least area (Visvalingam-Whyatt): a good inscribed quadrilateral or
-/// triangle of the hull, whatever the object's thickness.
-std::vector<Point> reduceTo(std::vector<Point> p, size_t target) {
-  const auto loss = [&p](size_t i) {
-    const size_t n = p.size();
-    return std::abs(cross(p[(i + n - 1) % n], p[i], p[(i + 1) % n]));
-  };
-  std::vector<double> losses(p.size());
-  for (size_t i = 0; i < p.size(); ++i) losses[i] = loss(i);
-  while (p.size() > target) {
-    const size_t best = static_cast<size_t>(std::min_element(losses.begin(), losses.end()) - losses.begin());
-    p.erase(p.begin() + static_cast<std::ptrdiff_t>(best));
-    losses.erase(losses.begin() + static_cast<std::ptrdiff_t>(best));
-    // Only the two neighbours of the removed vertex change.
-    const size_t n = p.size();
-    losses[(best + n - 1) % n] = loss((best + n - 1) % n);
-    losses[best % n] = loss(best % n);
-  }
-  return p;
-}
+using polygon::cross;
+using polygon::Point;
+using polygon::polygonArea;
+using polygon::reduceTo;
 
 /// The convex quadrilateral q moved inward by d on every side (intersections of the offset
 /// sides); false when it vanishes.
@@ -122,39 +91,8 @@ RegularVerdict testRegularMask(const RleMask& rle, const RegularMaskOptions& opt
   v.touches_border = cols.front().x == 0 || cols.back().x == rle.width - 1;
   for (const MaskColumn& c : cols) v.touches_border = v.touches_border || c.ymin == 0 || c.ymax == rle.height - 1;
 
-  // Convex hull of the pixel squares (Andrew's monotone chain): only the extreme corners of
-  // each vertical grid line X = x - 1/2 matter, and they come sorted by X.
-  std::vector<Point> top, bottom;  // per grid line: the highest and lowest corner
-  for (size_t i = 0; i <= cols.size(); ++i) {
-    // Grid line left of column i (and right of column i-1 when adjacent).
-    const bool has_left = i > 0, has_right = i < cols.size();
-    if (has_left && (!has_right || cols[i].x != cols[i - 1].x + 1)) {
-      const MaskColumn& c = cols[i - 1];  // closing the previous column on its right side
-      top.emplace_back(c.x + 0.5, c.ymin - 0.5);
-      bottom.emplace_back(c.x + 0.5, c.ymax + 0.5);
-    }
-    if (has_right) {
-      const MaskColumn& c = cols[i];
-      double lo = c.ymin, hi = c.ymax;
-      if (has_left && cols[i - 1].x == c.x - 1)
-        lo = std::min<double>(lo, cols[i - 1].ymin), hi = std::max<double>(hi, cols[i - 1].ymax);
-      top.emplace_back(c.x - 0.5, lo - 0.5);
-      bottom.emplace_back(c.x - 0.5, hi + 0.5);
-    }
-  }
-  // Image y points down: the upper chain keeps right turns on the top points, the lower chain
-  // on the bottom points walked backwards; together a closed hull.
-  std::vector<Point> hull;
-  for (const Point& p : top) {
-    while (hull.size() >= 2 && cross(hull[hull.size() - 2], hull.back(), p) <= 0) hull.pop_back();
-    hull.push_back(p);
-  }
-  const size_t upper = hull.size() + 1;
-  for (auto it = bottom.rbegin(); it != bottom.rend(); ++it) {
-    while (hull.size() >= upper && cross(hull[hull.size() - 2], hull.back(), *it) <= 0) hull.pop_back();
-    hull.push_back(*it);
-  }
-  while (hull.size() > 1 && (hull.back() - hull.front()).norm() < 1e-12) hull.pop_back();
+  v.hull = polygon::hullOfColumns(cols);
+  const std::vector<Point>& hull = v.hull;
   v.hull_vertices = static_cast<int>(hull.size());
   if (hull.size() < 3) return v;
   v.solidity = static_cast<double>(area) / polygonArea(hull);
@@ -187,6 +125,8 @@ RegularVerdict testRegularMask(const RleMask& rle, const RegularMaskOptions& opt
               v.min_corner_angle_deg >= options.min_corner_angle_deg;
   return v;
 }
+
+std::vector<Eigen::Vector2d> rleConvexHull(const RleMask& rle) { return polygon::hullOfColumns(rleColumns(rle)); }
 
 std::vector<Eigen::Vector2d> rleOutline(const RleMask& rle, bool* touches_border) {
   std::vector<Eigen::Vector2d> pts;

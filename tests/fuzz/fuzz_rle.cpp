@@ -25,7 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   (void)rleMoments(rle);
   (void)decodeMaskCrop(rle);
   const RegularVerdict v = testRegularMask(rle);
-  for (MaskFitMethod m : {MaskFitMethod::Moments, MaskFitMethod::Direct, MaskFitMethod::Quadrilateral}) {
+  for (MaskFitMethod m :
+       {MaskFitMethod::Moments, MaskFitMethod::Direct, MaskFitMethod::Quadrilateral, MaskFitMethod::Hull}) {
     const auto e = fitMaskEllipse(rle, m, &v);
     FUZZ_CHECK(!e || e->isValid());  // never NaN
   }

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <opencv2/imgproc.hpp>
 
 #include "ellreloc/core/distances.hpp"
@@ -7,6 +9,8 @@
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
+#include "ellreloc/observe/observe.hpp"
+#include "ellreloc/observe/regular_mask.hpp"
 #include "fixtures/data_dir.hpp"
 #include "fixtures/mask_outline.hpp"
 #include "fixtures/mask_shapes.hpp"
@@ -213,4 +217,130 @@ TEST(Mask, PolygonMaskEqualsPixelCentreRasterisation) {
   EXPECT_EQ(polygonMask({{1, 1}, {5, 1}}, H, W).counts, std::vector<uint32_t>{W * H});
   EXPECT_EQ(polygonMask({{1, 1}, {NAN, 1}, {3, 9}}, H, W).counts, std::vector<uint32_t>{W * H});
   EXPECT_EQ(polygonMask({{-50, -50}, {-40, -50}, {-45, -40}}, H, W).counts, std::vector<uint32_t>{W * H});
+}
+
+namespace {
+
+/// The convex hull of points, by OpenCV (which picks the vertices in float): the independent
+/// check of the library's hulls.
+std::vector<Eigen::Vector2d> cvHull(const std::vector<Eigen::Vector2d>& points) {
+  std::vector<cv::Point2f> in;
+  for (const auto& p : points) in.emplace_back(static_cast<float>(p(0)), static_cast<float>(p(1)));
+  std::vector<int> indices;
+  cv::convexHull(in, indices);
+  std::vector<Eigen::Vector2d> hull;
+  for (int i : indices) hull.push_back(points[static_cast<size_t>(i)]);
+  return hull;
+}
+
+double polygonArea(const std::vector<Eigen::Vector2d>& p) {
+  double a = 0;
+  for (size_t i = 0; i < p.size(); ++i) a += p[i](0) * p[(i + 1) % p.size()](1) - p[i](1) * p[(i + 1) % p.size()](0);
+  return 0.5 * std::abs(a);
+}
+
+}  // namespace
+
+TEST(EllipseFit, RleConvexHullIsTheHullOfThePixelSquares) {
+  std::mt19937 rng(17);
+  for (int i = 0; i < 30; ++i) {
+    BinaryMask m = test::rasterEllipse(test::randomEllipse(rng), 640, 480);
+    test::addBoundaryNoise(m, rng, 0.5);
+    std::vector<Eigen::Vector2d> corners;
+    for (int y = 0; y < m.height; ++y)
+      for (int x = 0; x < m.width; ++x)
+        if (m.at(x, y))
+          for (double dx : {-0.5, 0.5})
+            for (double dy : {-0.5, 0.5}) corners.emplace_back(x + dx, y + dy);
+    if (corners.empty()) continue;
+    const std::vector<Eigen::Vector2d> hull = rleConvexHull(encodeMask(m));
+    EXPECT_NEAR(polygonArea(hull), polygonArea(cvHull(corners)), 1e-6) << i;
+  }
+  EXPECT_TRUE(rleConvexHull(encodeMask(BinaryMask(48, 64))).empty());
+}
+
+TEST(EllipseFit, HullEllipseOfABoxSilhouetteIsTheImageOfItsInscribedEllipsoid) {
+  // In parallel projection a box's silhouette is the hexagon spanned by the images g_i of its
+  // half-edges, and its inscribed ellipsoid projects to the ellipse of shape sum g_i g_i^T.
+  std::mt19937 rng(29);
+  int tested = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Matrix3d R = test::randomRotation(rng);
+    const Eigen::Vector3d half(uniform(rng, 0.05, 0.5), uniform(rng, 0.05, 0.5), uniform(rng, 0.05, 0.5));
+    const Eigen::Matrix<double, 2, 3> A = 400.0 * test::randomRotation(rng).topRows<2>();  // px per metre
+    const Eigen::Vector2d centre(uniform(rng, 100, 500), uniform(rng, 100, 400));
+    const Eigen::Matrix<double, 2, 3> G = A * R * half.asDiagonal();  // columns: the g_i
+    // Two images of edges closer than 10 degrees to parallel are merged by design (a
+    // silhouette cannot tell them from one edge): not this test's case.
+    bool separable = true;
+    for (int a = 0; a < 3; ++a)
+      for (int b = a + 1; b < 3; ++b)
+        separable = separable && std::abs(G.col(a).normalized().dot(G.col(b).normalized())) < std::cos(12.0 * M_PI / 180.0);
+    if (!separable) continue;
+    ++tested;
+    std::vector<Eigen::Vector2d> corners;
+    for (double sx : {-1.0, 1.0})
+      for (double sy : {-1.0, 1.0})
+        for (double sz : {-1.0, 1.0}) corners.push_back(centre + G * Eigen::Vector3d(sx, sy, sz));
+    const Ellipse truth = *Ellipse::fromGaussian(centre, G * G.transpose());
+    const auto e = hullEllipse(cvHull(corners));
+    ASSERT_TRUE(e.has_value());
+    EXPECT_LT(wasserstein2(*e, truth), 1e-6 * truth.axes()(1)) << i;
+  }
+  EXPECT_GT(tested, 100);
+  // A face-on box, a parallelogram: the ellipse touches each side at its midpoint.
+  const std::vector<Eigen::Vector2d> quad = {{100, 100}, {300, 140}, {330, 260}, {130, 220}};
+  const auto e = hullEllipse(quad);
+  ASSERT_TRUE(e.has_value());
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(e->mahalanobisRadius(0.5 * (quad[k] + quad[(k + 1) % 4])), 1.0, 1e-9);
+}
+
+TEST(EllipseFit, HullEllipseOfARoundSilhouetteIsTheSilhouette) {
+  std::mt19937 rng(31);
+  for (int i = 0; i < 50; ++i) {
+    const Ellipse truth = test::randomEllipse(rng);
+    const auto e = hullEllipse(cvHull(truth.sampleBoundary(400)));
+    ASSERT_TRUE(e.has_value());
+    EXPECT_LT(wasserstein2(*e, truth), 0.01 * std::sqrt(truth.axes().prod())) << i;
+  }
+  // No area, no ellipse.
+  EXPECT_FALSE(hullEllipse({{0, 0}, {1, 1}}).has_value());
+  EXPECT_FALSE(hullEllipse({{0, 0}, {1, 1}, {2, 2}}).has_value());
+}
+
+TEST(EllipseFit, HullFitOfBoxMasksInPerspectiveBeatsTheBoxAndTheOutline) {
+  // Boxes at 1-3 m seen in perspective, masks with boundary noise: the truth is the projection
+  // of the ellipsoid inscribed in the box, which the silhouette overreaches.
+  std::mt19937 rng(37);
+  const Intrinsics K = test::testIntrinsics();
+  std::vector<double> hull_err, box_err, direct_err;
+  for (int i = 0; i < 120; ++i) {
+    const Eigen::Vector3d half(uniform(rng, 0.05, 0.3), uniform(rng, 0.05, 0.3), uniform(rng, 0.05, 0.3));
+    const Eigen::Matrix3d R = test::randomRotation(rng);
+    const Eigen::Vector3d centre(uniform(rng, -0.3, 0.3), uniform(rng, -0.2, 0.2), uniform(rng, 1.0, 3.0));
+    std::vector<Eigen::Vector2d> image;
+    for (double sx : {-1.0, 1.0})
+      for (double sy : {-1.0, 1.0})
+        for (double sz : {-1.0, 1.0}) image.push_back(K.project(centre + R * half.cwiseProduct(Eigen::Vector3d(sx, sy, sz))));
+    const Projection truth = project(Ellipsoid(centre, half, R), K, Pose());
+    ASSERT_TRUE(truth);
+    BinaryMask m = test::rasterPolygon(cvHull(image), K.width, K.height);
+    test::addBoundaryNoise(m, rng, 0.5);
+    const RleMask rle = encodeMask(m);
+    const auto moments = rleMoments(rle);
+    if (!moments || moments->area < 200) continue;
+    const Box& b = moments->bounds;  // cut by the image border: not this test's case
+    if (b.x1 < 0 || b.y1 < 0 || b.x2 > K.width - 1 || b.y2 > K.height - 1) continue;
+    const double scale = std::sqrt(truth.ellipse.axes().prod());
+    hull_err.push_back(wasserstein2(*fitMaskEllipse(rle, MaskFitMethod::Hull, nullptr), truth.ellipse) / scale);
+    box_err.push_back(wasserstein2(*Ellipse::inscribedInBox(moments->bounds), truth.ellipse) / scale);
+    direct_err.push_back(wasserstein2(*fitMaskEllipse(rle, MaskFitMethod::Direct, nullptr), truth.ellipse) / scale);
+  }
+  ASSERT_GT(hull_err.size(), 80u);
+  const auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  EXPECT_LT(median(hull_err), 0.5 * median(box_err));
+  EXPECT_LT(median(hull_err), 0.5 * median(direct_err));
 }

@@ -2,7 +2,8 @@
 /// \file ellipse_fit.hpp
 /// Ellipses from masks and points: the moment ellipse, the ellipse-specific direct
 /// least-squares fit (Fitzgibbon, Pilu & Fisher 1999, in Halir & Flusser's numerically stable
-/// form, 1998), and the projectively inscribed ellipse of a quadrilateral. Eigen only.
+/// form, 1998), the projectively inscribed ellipse of a quadrilateral, and the ellipse of a
+/// silhouette's convex hull. Eigen only.
 
 #include <Eigen/Dense>
 #include <array>
@@ -115,5 +116,19 @@ inline std::optional<Ellipse> projectivelyInscribedEllipse(const std::array<Eige
   const Eigen::Matrix3d C = H * Eigen::Vector3d(1, 1, -1).asDiagonal() * H.transpose();
   return Ellipse::fromDualConic(C);
 }
+
+/// The image of the ellipsoid inscribed in an object's cuboid, estimated from the convex hull of
+/// its silhouette (rleConvexHull of its mask). Two shapes bound what the hull can be:
+/// - a box: in parallel projection its silhouette is the zonotope sum_i a_i [-1, 1] of the
+///   images a_i of its three half-edges, and its inscribed ellipsoid projects to the ellipse of
+///   shape sum_i a_i a_i^T. The hull reduced to six corners, nearly parallel consecutive sides
+///   merged, has the sides +-2 a_i, so that shape is the sum of s s^T / 8 over its sides s;
+/// - an ellipsoid: the hull is its projection, the ellipse with 4x the hull's covariance.
+/// The hull is weighed between the two by the share of its area that six corners keep: all of
+/// a box's silhouette, 3 sqrt(3) / (2 pi) = 0.83 of an ellipse. A silhouette larger than the
+/// cuboid's inscribed ellipsoid's projection (a box seen on its corner spans up to sqrt(3)
+/// times it) thus gives an ellipse of that projection's size. nullopt for fewer than three
+/// points or no area.
+std::optional<Ellipse> hullEllipse(const std::vector<Eigen::Vector2d>& hull);
 
 }  // namespace ellreloc

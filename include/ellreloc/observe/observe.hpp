@@ -30,12 +30,13 @@ enum class MaskFitMethod {
   Moments,        ///< same second moments as the mask (from the RLE runs, no decoding)
   Direct,         ///< direct least squares on the outline, image-border points dropped
   Quadrilateral,  ///< regular masks: the projectively inscribed ellipse of the quadrilateral
+  Hull,           ///< the inscribed ellipsoid's image from the mask's convex hull (hullEllipse)
 };
 
 struct ObserveOptions {
   ObservationPolicy policy = ObservationPolicy::Paper;
   MaskFitMethod regular_fit = MaskFitMethod::Quadrilateral;  ///< for regular masks
-  MaskFitMethod irregular_fit = MaskFitMethod::Direct;       ///< for other masks (policy Mask)
+  MaskFitMethod irregular_fit = MaskFitMethod::Hull;         ///< for other masks (policy Mask)
   RegularMaskOptions regular;
   double border_px = 2.0;  ///< a box this close to the image border is flagged truncated
 
@@ -68,7 +69,7 @@ std::vector<Observation> observeDetections(const std::vector<Detection>& detecti
                                            const ObserveOptions& options = {});
 
 /// Fits an ellipse to a run-length mask with the given method (no decoding); `verdict` is
-/// needed by Quadrilateral.
+/// needed by Quadrilateral, and Hull takes the mask's hull from it when it has one.
 std::optional<Ellipse> fitMaskEllipse(const RleMask& rle, MaskFitMethod method, const RegularVerdict* verdict);
 
 }  // namespace ellreloc

@@ -40,6 +40,9 @@ struct RegularVerdict {
   double min_corner_angle_deg = 0.0;
   std::array<Eigen::Vector2d, 4> corners{};  ///< around the quadrilateral, on the mask's outer pixel edges
   bool touches_border = false;               ///< the mask reaches the image border
+  /// The convex hull of the mask's pixel squares (rleConvexHull), clockwise on screen; empty
+  /// for a mask below min_pixels. The hull fit reuses it.
+  std::vector<Eigen::Vector2d> hull;
 };
 
 /// Tests a run-length mask without decoding it: the convex hull of the pixel squares comes from
@@ -56,6 +59,10 @@ struct MaskColumn {
 
 /// The non-empty columns of a run-length mask, in increasing x. Empty if inconsistent.
 std::vector<MaskColumn> rleColumns(const RleMask& rle);
+
+/// The convex hull of the mask's pixel squares, clockwise on screen (y down); fewer than 3
+/// points for an empty or inconsistent mask. From the runs, no decoding.
+std::vector<Eigen::Vector2d> rleConvexHull(const RleMask& rle);
 
 /// Outline points of the mask with every column filled between its extreme rows (holes and
 /// vertical notches closed): midpoints of the pixel edges on its boundary, image-border edges
