@@ -9,8 +9,9 @@
 //   4. relocalization of the query frames with the perturbed map, the exact map and the voxel
 //      map of table 3 (observations to map to pose, all from the scene's files): ours (with
 //      and without the acceptance test), ours with box observations and with the mask policy's
-//      (every mask fitted), the OA-SLAM preset, and ours refined from the true pose (what the
-//      observations and the map allow at best) with the default and the mask policy.
+//      (every mask fitted), the OA-SLAM preset, and the refiner's optimum at the true pose
+//      with the matches found there (where the observations and the map put the pose when the
+//      search is perfect) with the default and the mask policy.
 // Run: build/benchmarks/scene_accuracy DIR [DIR...]
 #include <cstdio>
 #include <iterator>
@@ -125,6 +126,24 @@ ObjectMap scoreVoxelMap(const bench::SceneFolder& s) {
   return mapper.map();
 }
 
+/// The refiner's optimum from the true pose with the matches the score finds there, taken
+/// whatever its cost (sigma as the relocalizer's refinement gives it): where the observation
+/// ellipses and the map put the pose when the search is perfect. nullopt with fewer than two
+/// matches, as the relocalizer's refinement.
+std::optional<PoseError> refinerOptimumAtTruth(const ObjectRelocalizer& reloc, const std::vector<Observation>& obs,
+                                               const Pose& truth, const RelocalizerOptions& options) {
+  const RelocalizationResult at_truth = reloc.scorePose(obs, truth);
+  std::vector<EllipseMatch> matches;
+  for (const ObjectCorrespondence& m : at_truth.inliers) {
+    const Observation& o = obs[static_cast<size_t>(m.observation)];
+    const bool regular_fit = o.source == EllipseSource::Mask && o.regular.value_or(false);
+    matches.push_back({o.ellipse, reloc.map().objects[static_cast<size_t>(m.object)].ellipsoid,
+                       regular_fit ? options.refinement.regular_mask_sigma : 1.0});
+  }
+  if (matches.size() < 2) return std::nullopt;
+  return poseError(refinePose(reloc.intrinsics(), truth, matches, {}, options.refinement.refiner).pose, truth);
+}
+
 void relocalizeRow(const bench::SceneFolder& s, const char* map_name, const ObjectMap& map, const char* method,
                    const RelocalizerOptions& options, ObservationPolicy policy, bool from_truth) {
   const ObjectRelocalizer reloc(map, s.K, options);
@@ -133,7 +152,11 @@ void relocalizeRow(const bench::SceneFolder& s, const char* map_name, const Obje
     const Pose* truth = io::framePose(s.query_poses, f);
     if (!truth) continue;
     const std::vector<Observation> obs = observeDetections(f.detections, s.K.width, s.K.height, withPolicy(policy));
-    const RelocalizationResult r = from_truth ? reloc.refineFrom(obs, *truth) : reloc.relocalize(obs);
+    if (from_truth) {
+      errors.push_back(refinerOptimumAtTruth(reloc, obs, *truth, options));
+      continue;
+    }
+    const RelocalizationResult r = reloc.relocalize(obs);
     errors.push_back(r.status == RelocalizationStatus::Success ? std::optional(poseError(r.pose, *truth))
                                                                : std::nullopt);
   }
@@ -153,9 +176,10 @@ void scoreRelocalization(const bench::SceneFolder& s, const ObjectMap& voxel_map
     relocalizeRow(s, map_name, *map, "ours, every pose, box ellipses", every_pose, ObservationPolicy::Bbox, false);
     relocalizeRow(s, map_name, *map, "ours, every pose, mask policy", every_pose, ObservationPolicy::Mask, false);
     relocalizeRow(s, map_name, *map, "oa-slam preset", RelocalizerOptions::oaSlam(), ObservationPolicy::Bbox, false);
-    relocalizeRow(s, map_name, *map, "ours refined from the true pose", every_pose, ObservationPolicy::Paper, true);
-    relocalizeRow(s, map_name, *map, "ours refined from the true pose, mask policy", every_pose, ObservationPolicy::Mask,
+    relocalizeRow(s, map_name, *map, "the refiner's optimum at the true pose", every_pose, ObservationPolicy::Paper,
                   true);
+    relocalizeRow(s, map_name, *map, "the refiner's optimum at the true pose, mask policy", every_pose,
+                  ObservationPolicy::Mask, true);
   }
 }
 
