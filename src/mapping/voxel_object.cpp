@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <unordered_map>
 
 #include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
@@ -249,31 +250,41 @@ std::optional<Box> VoxelObject::projectedBox(const Intrinsics& K, const Pose& po
 
 long VoxelObject::countNear(const VoxelObject& other, double radius) const {
   const double size = options_.voxel_size;
-  const int reach = static_cast<int>(std::ceil(radius / size));
-  // Neighbour offsets within the radius, nearest first, so that most searches stop early.
-  std::vector<Eigen::Vector3i> offsets;
-  for (int dx = -reach; dx <= reach; ++dx)
-    for (int dy = -reach; dy <= reach; ++dy)
-      for (int dz = -reach; dz <= reach; ++dz)
-        if ((dx * dx + dy * dy + dz * dz) * size * size <= radius * radius + 1e-12) offsets.emplace_back(dx, dy, dz);
-  std::sort(offsets.begin(), offsets.end(),
-            [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) { return a.squaredNorm() < b.squaredNorm(); });
+  const double radius2 = radius * radius + 1e-12;  // two voxels are near: centres within the radius
+  const int reach = std::max(1, static_cast<int>(std::ceil(radius / size)));
   Eigen::AlignedBox3d reach_box = other.bounds();
   if (reach_box.isEmpty()) return 0;
   reach_box.min().array() -= radius + size;
   reach_box.max().array() += radius + size;
-  long n = 0;
-  for (const auto& [key, v] : voxels_) {
-    if (!occupied(v) || !reach_box.contains(centreOf(key))) continue;
-    const Eigen::Vector3i g = unpack(key);
-    for (const Eigen::Vector3i& o : offsets) {
-      const auto it = other.voxels_.find(pack(g(0) + o(0), g(1) + o(1), g(2) + o(2)));
-      if (it != other.voxels_.end() && other.occupied(it->second)) {
-        ++n;
-        break;
-      }
+  // The other's occupied voxels by cells of `reach` voxels a side: a voxel's neighbours within
+  // the radius lie in its own cell or the 26 around it.
+  const auto cellOf = [reach](const Eigen::Vector3i& g) {
+    const auto floorDiv = [reach](int a) { return a >= 0 ? a / reach : -((-a + reach - 1) / reach); };
+    return Eigen::Vector3i(floorDiv(g(0)), floorDiv(g(1)), floorDiv(g(2)));
+  };
+  std::unordered_map<uint64_t, std::vector<Eigen::Vector3i>> cells;
+  for (const auto& [key, v] : other.voxels_)
+    if (other.occupied(v)) {
+      const Eigen::Vector3i g = unpack(key), c = cellOf(g);
+      cells[pack(c(0), c(1), c(2))].push_back(g);
     }
-  }
+  const auto hasNeighbour = [&](uint64_t key) {
+    if (const auto same = other.voxels_.find(key); same != other.voxels_.end() && other.occupied(same->second))
+      return true;
+    const Eigen::Vector3i g = unpack(key), c = cellOf(g);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells.find(pack(c(0) + dx, c(1) + dy, c(2) + dz));
+          if (it == cells.end()) continue;
+          for (const Eigen::Vector3i& q : it->second)
+            if (static_cast<double>((q - g).squaredNorm()) * size * size <= radius2) return true;
+        }
+    return false;
+  };
+  long n = 0;
+  for (const auto& [key, v] : voxels_)
+    if (occupied(v) && reach_box.contains(centreOf(key)) && hasNeighbour(key)) ++n;
   return n;
 }
 

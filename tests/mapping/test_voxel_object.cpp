@@ -147,15 +147,18 @@ TEST(VoxelObject, CountNearIsEquationFourCounting) {
   EXPECT_EQ(a.countNear(a, 0.0), n);
   EXPECT_EQ(a.countNear(far, 0.05), 0);
   // b covers x >= 320 px; a's voxels with x_c >= (320 - 319.5) / 500 * 2 - r are near b's.
-  long expected = 0;
-  for (const Eigen::Vector3d& c : a.occupiedCentres()) {
-    bool near = false;
-    for (const Eigen::Vector3d& d : b.occupiedCentres()) near = near || (c - d).norm() <= 0.05 + 1e-9;
-    expected += near;
+  // Brute force over every pair, at radii below, at and above a voxel and across several.
+  for (const double r : {0.005, 0.01, 0.015, 0.03, 0.05}) {
+    long expected = 0;
+    for (const Eigen::Vector3d& c : a.occupiedCentres()) {
+      bool near = false;
+      for (const Eigen::Vector3d& d : b.occupiedCentres()) near = near || (c - d).norm() <= r + 1e-9;
+      expected += near;
+    }
+    EXPECT_EQ(a.countNear(b, r), expected) << r;
+    EXPECT_GT(expected, n / 3) << r;
+    EXPECT_LT(expected, n) << r;
   }
-  EXPECT_EQ(a.countNear(b, 0.05), expected);
-  EXPECT_GT(expected, n / 3);
-  EXPECT_LT(expected, n);
 }
 
 TEST(VoxelObject, PruneAndMemoryBudget) {
