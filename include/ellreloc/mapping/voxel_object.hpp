@@ -25,7 +25,9 @@
 namespace ellreloc {
 
 struct VoxelOptions {
-  double voxel_size = 0.02;       ///< metres
+  /// Metres. 1 cm resolves the thin sides of books, keyboards and monitors (2-4 cm), which a
+  /// 2 cm voxel measures to a voxel (axis errors 15-23% instead of 9-10%), at 4-5x the memory.
+  double voxel_size = 0.01;
   double hit_probability = 0.7;   ///< P(n | z) of a depth pixel inside the mask (OctoMap's default)
   double miss_probability = 0.3;  ///< P(n | z) of a voxel seen outside the mask or in free space
   double clamp_min = 0.12;        ///< probabilities are clamped to [clamp_min, clamp_max]
