@@ -51,16 +51,19 @@ std::optional<Ellipse> hullEllipse(const std::vector<Eigen::Vector2d>& hull) {
   // one: a side the reduction split (noise along a straight edge). Two edges of a box whose
   // images are that close to parallel are merged too: a silhouette cannot tell them apart.
   const double kParallel = std::cos(10.0 * M_PI / 180.0);
+  const auto parallel = [kParallel](const Point& a, const Point& b) {
+    return a.dot(b) > kParallel * a.norm() * b.norm();
+  };
   const std::vector<Point> corners = polygon::reduceTo(hull, 6);
   std::vector<Point> sides;
   for (size_t i = 0; i < corners.size(); ++i) {
     const Point side = corners[(i + 1) % corners.size()] - corners[i];
-    if (!sides.empty() && side.dot(sides.back()) > kParallel * side.norm() * sides.back().norm())
+    if (!sides.empty() && parallel(side, sides.back()))
       sides.back() += side;
     else
       sides.push_back(side);
   }
-  if (sides.size() > 2 && sides.front().dot(sides.back()) > kParallel * sides.front().norm() * sides.back().norm()) {
+  if (sides.size() > 2 && parallel(sides.front(), sides.back())) {
     sides.front() += sides.back();
     sides.pop_back();
   }
