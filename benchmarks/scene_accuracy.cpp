@@ -127,19 +127,13 @@ ObjectMap scoreVoxelMap(const bench::SceneFolder& s) {
 }
 
 /// The refiner's optimum from the true pose with the matches the score finds there, taken
-/// whatever its cost (sigma as the relocalizer's refinement gives it): where the observation
+/// whatever its cost (each match weighed as the relocalizer's refinement weighs it): where the observation
 /// ellipses and the map put the pose when the search is perfect. nullopt with fewer than two
 /// matches, as the relocalizer's refinement.
 std::optional<PoseError> refinerOptimumAtTruth(const ObjectRelocalizer& reloc, const std::vector<Observation>& obs,
                                                const Pose& truth, const RelocalizerOptions& options) {
   const RelocalizationResult at_truth = reloc.scorePose(obs, truth);
-  std::vector<EllipseMatch> matches;
-  for (const ObjectCorrespondence& m : at_truth.inliers) {
-    const Observation& o = obs[static_cast<size_t>(m.observation)];
-    const bool regular_fit = o.source == EllipseSource::Mask && o.regular.value_or(false);
-    matches.push_back({o.ellipse, reloc.map().objects[static_cast<size_t>(m.object)].ellipsoid,
-                       regular_fit ? options.refinement.regular_mask_sigma : 1.0});
-  }
+  const std::vector<EllipseMatch> matches = reloc.refinementMatches(obs, at_truth.inliers);
   if (matches.size() < 2) return std::nullopt;
   return poseError(refinePose(reloc.intrinsics(), truth, matches, {}, options.refinement.refiner).pose, truth);
 }

@@ -330,6 +330,7 @@ class ObjectRelocalizer:
     def observe(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection]) -> list[Observation]: """The observations relocalize() makes of a frame."""
     def score_pose(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], pose: Pose) -> RelocalizationResult: """Scores a pose from elsewhere the way relocalize() scores its hypotheses."""
     def refine_from(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], start: Pose) -> RelocalizationResult: """Refines a given pose against the objects it matches, then scores it."""
+    def refinement_matches(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], matches: Sequence[EllipseMatch | tuple[Ellipse, Ellipsoid]]) -> list[ellreloc::EllipseMatch]: """The EllipseMatch pairs relocalize() refines on for these matches (e.g. a result's inliers), each weighed as the refinement weighs it; for refine_pose()."""
     map: ObjectMap
     camera: Intrinsics
     options: RelocalizerOptions

@@ -372,6 +372,15 @@ void bindRelocalizer(py::module_& m) {
             return r.relocalizer.refineFrom(obs, start);
           },
           py::arg("frame"), py::arg("start"), "Refines a given pose against the objects it matches, then scores it.")
+      .def(
+          "refinement_matches",
+          [](const Relocalizer& r, const py::handle& frame, const std::vector<ObjectCorrespondence>& matches) {
+            const std::vector<Observation> obs = observationsFrom(r, frame, nullptr);
+            return r.relocalizer.refinementMatches(obs, matches);
+          },
+          py::arg("frame"), py::arg("matches"),
+          "The EllipseMatch pairs relocalize() refines on for these matches (e.g. a result's inliers), each weighed "
+          "as the refinement weighs it; for refine_pose().")
       .def_property_readonly("map", [](const Relocalizer& r) { return r.relocalizer.map(); })
       .def_property_readonly("camera", [](const Relocalizer& r) { return r.relocalizer.intrinsics(); })
       .def_property_readonly(

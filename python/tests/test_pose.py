@@ -74,6 +74,9 @@ def test_scoring_refining_and_the_refiner(office):
     result = E.refine_pose(camera, start, matches)
     assert result.final_cost < result.initial_cost and not result.fell_back
     assert E.pose_error(result.pose, truth).position_cm < 0.5
+    pairs = relocalizer.refinement_matches(observations, scored.matches)
+    assert [p.sigma for p in pairs] == [1.0] * len(observations)
+    assert E.pose_error(E.refine_pose(camera, start, pairs).pose, truth).position_cm < 0.5
     X = np.array([[0.1, 0.2, 0.5], [1.0, -0.5, 0.8], [-0.7, 0.4, 1.1], [0.3, 0.9, 0.2]])
     uv = np.array([camera.project(x) for x in truth.transform(X)])
     with_points = E.refine_pose(camera, start, matches[:1], points_2d=uv, points_3d=X)

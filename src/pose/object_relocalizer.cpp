@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <string>
 
+#include "ellreloc/error.hpp"
 #include "pipeline/candidates.hpp"
 #include "pipeline/hypothesis_estimator.hpp"
 #include "pipeline/hypothesis_pool.hpp"
@@ -113,6 +115,20 @@ RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation
   RelocalizationResult result = scorePose(observations, refined.pose);
   result.refined = refined.refined;
   return result;
+}
+
+std::vector<EllipseMatch> ObjectRelocalizer::refinementMatches(const std::vector<Observation>& observations,
+                                                               const std::vector<ObjectCorrespondence>& matches) const {
+  for (const ObjectCorrespondence& m : matches) {
+    if (m.observation < 0 || static_cast<size_t>(m.observation) >= observations.size())
+      throw Error("refinementMatches: observation index " + std::to_string(m.observation) + " out of range (" +
+                  std::to_string(observations.size()) + " observations)");
+    if (m.object < 0 || static_cast<size_t>(m.object) >= map_.objects.size())
+      throw Error("refinementMatches: object index " + std::to_string(m.object) + " out of range (" +
+                  std::to_string(map_.objects.size()) + " map objects)");
+  }
+  const std::optional<GravityPrior> no_gravity;
+  return ellipseMatches(matches, RefinementContext{observations, map_, K_, options_, no_gravity, PoseGate{}});
 }
 
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations) const {

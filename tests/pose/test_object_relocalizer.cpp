@@ -505,6 +505,40 @@ TEST(ObjectRelocalizer, ScoresAGivenPose) {
             RelocalizationStatus::InvalidInput);
 }
 
+// The pairs a host refines on: each observation's ellipse with its matched object's ellipsoid,
+// a regular mask's fit weighed by regular_mask_sigma; refined from a perturbed truth they give
+// the truth back (exact projections), and an index out of range is refused.
+TEST(ObjectRelocalizer, RefinementMatchesArePairedAndWeighedAsTheRefinement) {
+  std::mt19937 rng(105);
+  const Intrinsics K = test::testIntrinsics();
+  Synthetic s = makeSceneSeeing(rng, 4, 12, 12, 0.0);
+  s.observations[0].source = EllipseSource::Mask;
+  s.observations[0].regular = true;
+  RelocalizerOptions options;
+  options.refinement.regular_mask_sigma = 0.25;
+  const ObjectRelocalizer reloc(s.map, K, options);
+  const RelocalizationResult at_truth = reloc.scorePose(s.observations, s.truth);
+  const std::vector<EllipseMatch> pairs = reloc.refinementMatches(s.observations, at_truth.inliers);
+  ASSERT_EQ(pairs.size(), at_truth.inliers.size());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const ObjectCorrespondence& c = at_truth.inliers[i];
+    EXPECT_TRUE(pairs[i].observed.center().isApprox(s.observations[c.observation].ellipse.center()));
+    EXPECT_TRUE(pairs[i].ellipsoid.center().isApprox(s.map.objects[c.object].ellipsoid.center()));
+    EXPECT_DOUBLE_EQ(pairs[i].sigma, c.observation == 0 ? 0.25 : 1.0);
+  }
+  const Pose start(Eigen::AngleAxisd(0.03, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() *
+                       s.truth.rotation(),
+                   s.truth.translation() + Eigen::Vector3d(0.05, -0.04, 0.03));
+  const Pose refined = refinePose(K, start, pairs, {}, options.refinement.refiner).pose;
+  EXPECT_LT(positionError(refined, s.truth), 0.01);
+  std::vector<ObjectCorrespondence> bad = at_truth.inliers;
+  bad[0].object = static_cast<int>(s.map.objects.size());
+  EXPECT_THROW(reloc.refinementMatches(s.observations, bad), Error);
+  bad = at_truth.inliers;
+  bad[0].observation = -1;
+  EXPECT_THROW(reloc.refinementMatches(s.observations, bad), Error);
+}
+
 // A match through a label the object carried in 10% of its detections is worth a fifth of one
 // through its majority label (share / 0.5), unless weigh_minority_labels is off.
 TEST(ObjectRelocalizer, MinorityLabelsWeighLess) {

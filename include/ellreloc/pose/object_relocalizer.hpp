@@ -108,6 +108,13 @@ class ObjectRelocalizer {
   /// `refined` says whether refinement moved it.
   RelocalizationResult refineFrom(const std::vector<Observation>& observations, const Pose& start) const;
 
+  /// The ellipse-ellipsoid pairs relocalize() refines a pose on, for `matches` (e.g. a result's
+  /// inliers): each observation's ellipse and its object's ellipsoid, with the refinement's
+  /// weight for that ellipse (refinement.regular_mask_sigma for a regular mask's fit, else 1).
+  /// For a host's own refinePose() call. Throws ellreloc::Error on an index out of range.
+  std::vector<EllipseMatch> refinementMatches(const std::vector<Observation>& observations,
+                                              const std::vector<ObjectCorrespondence>& matches) const;
+
   const ObjectMap& map() const { return map_; }
   /// "object ID: WHY" for each object of the map that is never matched.
   const std::vector<std::string>& leftOut() const { return left_out_; }
