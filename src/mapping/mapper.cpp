@@ -177,7 +177,7 @@ void Mapper::rebuild(Track& track) const {
   if (options_.mode == MappingMode::Voxel) {
     EllipsoidBuilderOptions builder = options_.ellipsoid;
     if (floor_normal_sum_.norm() > 0.0) builder.up = floor_normal_sum_.normalized();
-    const auto built = buildEllipsoid(track.voxels.occupiedCentres(options_.ellipsoid_min_probability), builder);
+    const auto built = buildEllipsoid(track.voxels.occupiedPointMeans(options_.ellipsoid_min_probability), builder);
     if (!built) return;  // keeps the previous ellipsoid, if any
     m.object.ellipsoid = built->ellipsoid;
     m.cuboid = built->cuboid;

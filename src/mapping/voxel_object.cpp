@@ -90,6 +90,18 @@ Eigen::Vector3d VoxelObject::centreOf(uint64_t key) const {
   return (unpack(key).cast<double>().array() + 0.5).matrix() * options_.voxel_size;
 }
 
+void VoxelObject::addToMean(Voxel& v, const Eigen::Vector3d& offset, long count) {
+  constexpr long kMaxPoints = 65535;
+  if (count <= 0) return;
+  const long total = std::min(kMaxPoints, static_cast<long>(v.points) + count);
+  const double weight = static_cast<double>(count) / static_cast<double>(std::max<long>(total, count));
+  for (int k = 0; k < 3; ++k) {
+    const double mean = v.mean[k] + weight * (offset(k) * kMeanUnits - v.mean[k]);
+    v.mean[k] = static_cast<int16_t>(std::lround(std::clamp(mean, -32767.0, 32767.0)));
+  }
+  v.points = static_cast<uint16_t>(total);
+}
+
 bool VoxelObject::occupied(const Voxel& v) const {
   return v.log_odds >= static_cast<float>(logit(options_.occupied_probability));
 }
@@ -125,11 +137,13 @@ VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const 
       const double d = depth.at(x, y);
       if (!(d >= gate_lo && d <= gate_hi)) continue;
       const Eigen::Vector3d x_c((x - K.cx) / K.fx * d, (y - K.cy) / K.fy * d, d);
-      const auto key = keyOf(R_wc * x_c + c_w);
+      const Eigen::Vector3d x_w = R_wc * x_c + c_w;
+      const auto key = keyOf(x_w);
       if (!key) continue;
       auto [it, inserted] = voxels_.try_emplace(*key);
       Voxel& v = it->second;
       if (inserted) ++update.added;
+      addToMean(v, (x_w - centreOf(*key)) / options_.voxel_size, 1);  // every point, not once per keyframe
       if (v.stamp == frames_) continue;
       v.stamp = frames_;
       v.log_odds = std::min(l_max, v.log_odds + l_hit);
@@ -203,6 +217,7 @@ void VoxelObject::absorb(const VoxelObject& other) {
   for (const auto& [key, theirs] : other.voxels_) {
     Voxel& v = voxels_[key];
     v.log_odds = std::clamp(v.log_odds + theirs.log_odds, l_min, l_max);
+    addToMean(v, Eigen::Vector3d(theirs.mean[0], theirs.mean[1], theirs.mean[2]) / kMeanUnits, theirs.points);
     v.stamp = frames_;  // counts as touched by this object's latest keyframe, not by a future one
   }
   enforceBudget();
@@ -214,13 +229,30 @@ size_t VoxelObject::occupiedCount() const {
   return n;
 }
 
-std::vector<Eigen::Vector3d> VoxelObject::occupiedCentres(std::optional<double> min_probability) const {
+float VoxelObject::logOddsCut(std::optional<double> min_probability) const {
   const double p = std::clamp(min_probability.value_or(options_.occupied_probability), 1e-9, 1.0 - 1e-9);
-  const float cut = static_cast<float>(logit(p));
+  return static_cast<float>(logit(p));
+}
+
+Eigen::Vector3d VoxelObject::pointMeanOf(uint64_t key, const Voxel& v) const {
+  return centreOf(key) + Eigen::Vector3d(v.mean[0], v.mean[1], v.mean[2]) * (options_.voxel_size / kMeanUnits);
+}
+
+std::vector<Eigen::Vector3d> VoxelObject::occupiedCentres(std::optional<double> min_probability) const {
+  const float cut = logOddsCut(min_probability);
   std::vector<Eigen::Vector3d> out;
   out.reserve(voxels_.size());
   for (const auto& [key, v] : voxels_)
     if (v.log_odds >= cut) out.push_back(centreOf(key));
+  return out;
+}
+
+std::vector<Eigen::Vector3d> VoxelObject::occupiedPointMeans(std::optional<double> min_probability) const {
+  const float cut = logOddsCut(min_probability);
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(voxels_.size());
+  for (const auto& [key, v] : voxels_)
+    if (v.log_odds >= cut) out.push_back(pointMeanOf(key, v));
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <thread>
 
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/mapping/mapper.hpp"
@@ -25,6 +26,7 @@ int objectsNear(const ObjectMap& map, const Eigen::Vector3d& centre, double radi
 // once. Known limit: neighbours of one category a few centimetres apart can merge.
 TEST(Mapper, MapsRenderedOfficesWithNoisyDepthAndMasks) {
   int checked = 0, good = 0;
+  std::vector<double> axis_errors;
   for (const uint64_t seed : {3, 7}) {
     const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Office, seed, 40, test::mappingNoise());
     Mapper mapper(seq.K);
@@ -48,6 +50,12 @@ TEST(Mapper, MapsRenderedOfficesWithNoisyDepthAndMasks) {
       good += (best->ellipsoid.center() - truth.box_center).norm() < 0.06 && best->category == truth.category &&
               objectsNear(map, truth.box_center, 0.1) == 1 &&
               best->ellipsoid.axes().maxCoeff() < truth.box_half.maxCoeff() + 0.1;
+      if ((best->ellipsoid.center() - truth.box_center).norm() < 0.06)
+        for (int k = 0; k < 3; ++k) {  // the estimate's extent along each true axis
+          const Eigen::Vector3d u = truth.box_rotation.col(k);
+          axis_errors.push_back(std::abs(std::sqrt(u.dot(best->ellipsoid.shapeMatrix() * u)) - truth.box_half(k)) /
+                                truth.box_half(k));
+        }
     }
     EXPECT_GE(checked_here, 15);
     EXPECT_LE(map.objects.size(), static_cast<size_t>(checked_here) + 3);
@@ -60,6 +68,10 @@ TEST(Mapper, MapsRenderedOfficesWithNoisyDepthAndMasks) {
     }
   }
   EXPECT_GE(good, 0.85 * checked) << good << " of " << checked;  // measured: 35 of 40
+  // Extents from the voxels' mean depth points, not their centres: median error along the true
+  // axes 9.4% (12.0% from the centres, whose steps of a voxel blur the thin sides of books and
+  // monitors).
+  EXPECT_LT(median(axis_errors), 0.105) << axis_errors.size() << " axes";
 }
 
 TEST(Mapper, LabelNoiseDoesNotSplitObjectsOrChangeTheirLabel) {

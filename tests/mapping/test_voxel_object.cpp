@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/mapping/voxel_object.hpp"
 
@@ -87,6 +88,42 @@ TEST(VoxelObject, VoxelsLieOnTheBackProjectedSurfaceAndProjectToTheMask) {
   EXPECT_NEAR(box->x2, 390, voxel_px);
   EXPECT_NEAR(box->y1, 200, voxel_px);
   EXPECT_NEAR(box->y2, 300, voxel_px);
+}
+
+// Each voxel keeps the mean of the depth points that fell in it: on a plane, the means lie on
+// the plane (to the storage's 1/65536 of a voxel) where the centres are up to half a voxel off;
+// fused models average their points by count.
+TEST(VoxelObject, PointMeansLieOnTheSurface) {
+  VoxelObject v;
+  const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
+  v.integrate(kK, camera, flatDepth(2.5f), rectMask(250, 200, 390, 300));
+  const std::vector<Eigen::Vector3d> means = v.occupiedPointMeans(), centres = v.occupiedCentres();
+  ASSERT_EQ(means.size(), centres.size());
+  ASSERT_GT(means.size(), 100u);
+  const double voxel = v.options().voxel_size;
+  double farthest_centre = 0.0;
+  for (size_t i = 0; i < means.size(); ++i) {
+    EXPECT_NEAR(camera.transform(means[i]).z(), 2.5, 1e-5);
+    EXPECT_LE((means[i] - centres[i]).cwiseAbs().maxCoeff(), 0.5 * voxel + 1e-9);  // in its own voxel
+    farthest_centre = std::max(farthest_centre, std::abs(camera.transform(centres[i]).z() - 2.5));
+  }
+  EXPECT_GT(farthest_centre, 0.3 * voxel);
+
+  // A fronto-parallel plane inside one layer of voxels (z in [2.00, 2.01)): one model saw it at
+  // 2.0031 once, the other at 2.0071 three times over the same pixels; fused, every voxel's
+  // mean is 2.0031 + 3/4 of the way to 2.0071 wherever both models hold it evenly.
+  VoxelObject a, b;
+  const BinaryMask mask = rectMask(300, 220, 340, 260);
+  a.integrate(kK, Pose(), flatDepth(2.0031f), mask);
+  for (int i = 0; i < 3; ++i) b.integrate(kK, Pose(), flatDepth(2.0071f), mask);
+  a.absorb(b);
+  std::vector<double> z;
+  for (const Eigen::Vector3d& m : a.occupiedPointMeans(0.01)) {
+    EXPECT_GE(m.z(), 2.0031 - 1e-5);
+    EXPECT_LE(m.z(), 2.0071 + 1e-5);
+    z.push_back(m.z());
+  }
+  EXPECT_NEAR(median(z), 2.0031 + 0.75 * 0.004, 2e-4);
 }
 
 TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {

@@ -2,9 +2,10 @@
 /// \file ellipsoid_builder.hpp
 /// The paper's "Accurate Ellipsoids Generation": objects stand on the ground, so their pose
 /// reduces to a yaw about gravity. The yaw is that of the smallest rectangle around the object's
-/// voxels projected onto the ground plane (the paper: the main axis of their PCA, which
-/// YawMethod::Pca keeps); extents along the two ground axes and gravity come from
-/// robust percentiles of the voxel coordinates; the ellipsoid is the one inscribed in that
+/// points (the mapper's: one per occupied voxel, the mean of the depth points in it) projected
+/// onto the ground plane (the paper: the main axis of their PCA, which YawMethod::Pca keeps);
+/// extents along the two ground axes and gravity come from robust percentiles of the point
+/// coordinates; the ellipsoid is the one inscribed in that
 /// cuboid (eqs. 5-6: Q* = Z^T diag(l^2/4, w^2/4, h^2/4, -1) Z).
 
 #include <Eigen/Core>
@@ -40,7 +41,7 @@ struct Cuboid {
   Ellipsoid inscribedEllipsoid() const { return Ellipsoid(center, half, rotation); }
 };
 
-/// How the yaw is found from the ground-plane footprint of the voxels.
+/// How the yaw is found from the ground-plane footprint of the points.
 enum class YawMethod {
   Pca,               ///< main axis of a (trimmed) PCA, the paper's method
   MinAreaRectangle,  ///< the smallest rectangle around the trimmed footprint (rotating calipers)
@@ -51,14 +52,14 @@ struct EllipsoidBuilderOptions {
   /// The smallest rectangle is the default: PCA leans towards the diagonal of a box whose back
   /// was never seen, and of a square footprint (docs/benchmarks.md, "Object mapping").
   YawMethod yaw = YawMethod::MinAreaRectangle;
-  /// Extents span these percentiles of the voxel coordinates along each axis, which ignores
+  /// Extents span these percentiles of the point coordinates along each axis, which ignores
   /// a few outlier voxels that survived the label filter.
   double low_percentile = 0.01;
   double high_percentile = 0.99;
-  /// Added to each half-extent. Voxel centres lie within half a voxel of the surface, on
-  /// either side, so the percentile span needs no padding by default.
+  /// Added to each half-extent. The mapper's points lie on the measured surface, so the
+  /// percentile span needs no padding by default.
   double extent_padding = 0.0;
-  size_t min_points = 8;  ///< fewer voxels: no ellipsoid
+  size_t min_points = 8;  ///< fewer points: no ellipsoid
 };
 
 struct BuiltEllipsoid {
@@ -131,7 +132,7 @@ inline Eigen::Matrix3d groundBasis(const Eigen::Vector3d& up) {
   return B;
 }
 
-/// Builds the yaw-only cuboid and its inscribed ellipsoid from an object's voxel centres
+/// Builds the yaw-only cuboid and its inscribed ellipsoid from an object's points
 /// (world coordinates). nullopt with fewer than options.min_points points, a zero or
 /// non-finite `up`, or a degenerate (flat) point set.
 inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vector3d>& points,

@@ -7,7 +7,8 @@
 /// the last keyframes and matched in 3D against the whole map (association.hpp); an object
 /// enters the map after `min_observations` (omega0 = 3) observations, its label is its most
 /// frequent category, its low-probability voxels are pruned at every update, and its
-/// ellipsoid comes from the PCA yaw builder (ellipsoid_builder.hpp).
+/// ellipsoid comes from its occupied voxels' mean depth points through the yaw builder
+/// (ellipsoid_builder.hpp).
 /// Boxes mode (monocular): detections are tracked by their boxes, and each object's ellipsoid
 /// is fitted to its boxes (box_ellipsoid_builder.hpp).
 ///

@@ -86,6 +86,11 @@ class VoxelObject {
   /// Centres of the voxels at or above `min_probability` (default: the occupied ones), in
   /// world coordinates.
   std::vector<Eigen::Vector3d> occupiedCentres(std::optional<double> min_probability = std::nullopt) const;
+  /// For each voxel at or above `min_probability` (default: the occupied ones), the mean of the
+  /// depth points that fell in it, in world coordinates: the measured surface to a fraction of
+  /// a voxel, where a voxel's centre is up to half a voxel off it (what the ellipsoid builder
+  /// reads: extents and yaw free of the grid's steps).
+  std::vector<Eigen::Vector3d> occupiedPointMeans(std::optional<double> min_probability = std::nullopt) const;
   /// The box of the occupied voxels projected into a camera (clipped to the image), or nullopt
   /// when fewer than `min_voxels` of them land in front of the camera inside the image.
   std::optional<Box> projectedBox(const Intrinsics& K, const Pose& pose, int min_voxels = 10) const;
@@ -107,7 +112,18 @@ class VoxelObject {
   struct Voxel {
     float log_odds = 0.0f;
     uint32_t stamp = 0;  ///< the keyframe that last touched it (one update per keyframe)
+    /// The mean of the depth points that fell in it, from its centre, in 1/65536 of a voxel
+    /// (a voxel spans [-32768, 32768)); `points` of them, counted up to 65535 (later points
+    /// then move the mean by 1/65535 of their offset each).
+    int16_t mean[3] = {0, 0, 0};
+    uint16_t points = 0;
   };
+  static constexpr double kMeanUnits = 65536.0;  ///< Voxel::mean units per voxel
+  /// Adds points (`count` of them, with mean offset `offset` in voxel units) to a voxel's mean.
+  static void addToMean(Voxel& v, const Eigen::Vector3d& offset, long count);
+  /// The log-odds at or above which a voxel counts, for `min_probability` (default: occupied).
+  float logOddsCut(std::optional<double> min_probability) const;
+  Eigen::Vector3d pointMeanOf(uint64_t key, const Voxel& v) const;
   static uint64_t pack(int x, int y, int z);
   static Eigen::Vector3i unpack(uint64_t key);
   std::optional<uint64_t> keyOf(const Eigen::Vector3d& x_w) const;
