@@ -43,8 +43,10 @@ struct Cuboid {
 
 /// How the yaw is found from the ground-plane footprint of the points.
 enum class YawMethod {
-  Pca,               ///< main axis of a (trimmed) PCA, the paper's method
-  MinAreaRectangle,  ///< the smallest rectangle around the trimmed footprint (rotating calipers)
+  Pca,  ///< main axis of a (trimmed) PCA, the paper's method
+  /// the smallest rectangle around the trimmed footprint (rotating calipers), polished to the
+  /// smallest rectangle of its percentiles within 4 degrees
+  MinAreaRectangle,
 };
 
 struct EllipsoidBuilderOptions {
@@ -120,6 +122,45 @@ inline std::optional<Eigen::Vector2d> minAreaRectangleAxis(std::vector<Eigen::Ve
   return best;
 }
 
+/// The direction of the longer side of the smallest percentile rectangle of 2D points (the
+/// rectangle percentileRectangle() gives, the extents the cuboid takes) within `reach` radians
+/// of `start`: a sweep in 1 degree steps, then a golden-section search around its best. At most
+/// `max_points` points (every k-th) are used: it runs at each update of an object.
+inline Eigen::Vector2d smallestPercentileRectangleNear(const std::vector<Eigen::Vector2d>& points,
+                                                       const Eigen::Vector2d& start, double reach, double low,
+                                                       double high, size_t max_points) {
+  const size_t stride = std::max<size_t>(1, (points.size() + max_points - 1) / max_points);
+  std::vector<Eigen::Vector2d> p;
+  for (size_t i = 0; i < points.size(); i += stride) p.push_back(points[i]);
+  std::vector<double> along, across;
+  Eigen::Vector2d lo, hi;
+  const auto direction = [](double t) { return Eigen::Vector2d(std::cos(t), std::sin(t)); };
+  const auto area = [&](double t) {
+    percentileRectangle(p, direction(t), low, high, &along, &across, &lo, &hi);
+    return (hi - lo).prod();
+  };
+  constexpr double kStep = M_PI / 180.0;
+  const double t0 = std::atan2(start.y(), start.x());
+  const int steps = static_cast<int>(std::ceil(reach / kStep));
+  double best_t = t0, best_area = area(t0);
+  for (int i = -steps; i <= steps; ++i)
+    if (const double a = area(t0 + i * kStep); i != 0 && a < best_area) best_area = a, best_t = t0 + i * kStep;
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = best_t - kStep, b = best_t + kStep;
+  double c = b - ratio * (b - a), d = a + ratio * (b - a), fc = area(c), fd = area(d);
+  while (b - a > 1e-6) {
+    if (fc < fd) {
+      b = d, d = c, fd = fc, c = b - ratio * (b - a), fc = area(c);
+    } else {
+      a = c, c = d, fc = fd, d = a + ratio * (b - a), fd = area(d);
+    }
+  }
+  const double t = std::min(fc, fd) < best_area ? 0.5 * (a + b) : best_t;
+  percentileRectangle(p, direction(t), low, high, &along, &across, &lo, &hi);
+  const Eigen::Vector2d u = direction(t);
+  return (hi - lo).x() >= (hi - lo).y() ? u : Eigen::Vector2d(-u.y(), u.x());
+}
+
 }  // namespace detail
 
 /// A right-handed world basis (e1, e2, up) with e1, e2 spanning the ground plane.
@@ -177,7 +218,12 @@ inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vec
       if (inlier[i]) footprint.push_back(ground[i]);
     const auto axis = detail::minAreaRectangleAxis(footprint);
     if (!axis) return std::nullopt;
-    main = *axis;
+    // The hull's rectangle rests on the outermost points, which a few stray voxels set; the
+    // yaw is polished to the smallest percentile rectangle within 4 degrees of it. A wider
+    // search can fall to the diagonal of a box seen on two faces only (an L-shaped footprint),
+    // whose percentile rectangle is as small as the true one.
+    main = detail::smallestPercentileRectangleNear(footprint, *axis, 4.0 * M_PI / 180.0, options.low_percentile,
+                                                   options.high_percentile, 512);
     detail::percentileRectangle(ground, main, options.low_percentile, options.high_percentile, &along, &across, &lo,
                                 &hi);
   }
