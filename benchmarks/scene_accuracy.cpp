@@ -131,11 +131,11 @@ ObjectMap scoreVoxelMap(const bench::SceneFolder& s) {
 /// ellipses and the map put the pose when the search is perfect. nullopt with fewer than two
 /// matches, as the relocalizer's refinement.
 std::optional<PoseError> refinerOptimumAtTruth(const ObjectRelocalizer& reloc, const std::vector<Observation>& obs,
-                                               const Pose& truth, const RelocalizerOptions& options) {
+                                               const Pose& truth) {
   const RelocalizationResult at_truth = reloc.scorePose(obs, truth);
   const std::vector<EllipseMatch> matches = reloc.refinementMatches(obs, at_truth.inliers);
   if (matches.size() < 2) return std::nullopt;
-  return poseError(refinePose(reloc.intrinsics(), truth, matches, {}, options.refinement.refiner).pose, truth);
+  return poseError(refinePose(reloc.intrinsics(), truth, matches, {}, reloc.options().refinement.refiner).pose, truth);
 }
 
 void relocalizeRow(const bench::SceneFolder& s, const char* map_name, const ObjectMap& map, const char* method,
@@ -147,7 +147,7 @@ void relocalizeRow(const bench::SceneFolder& s, const char* map_name, const Obje
     if (!truth) continue;
     const std::vector<Observation> obs = observeDetections(f.detections, s.K.width, s.K.height, withPolicy(policy));
     if (from_truth) {
-      errors.push_back(refinerOptimumAtTruth(reloc, obs, *truth, options));
+      errors.push_back(refinerOptimumAtTruth(reloc, obs, *truth));
       continue;
     }
     const RelocalizationResult r = reloc.relocalize(obs);

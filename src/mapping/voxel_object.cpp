@@ -238,22 +238,23 @@ Eigen::Vector3d VoxelObject::pointMeanOf(uint64_t key, const Voxel& v) const {
   return centreOf(key) + Eigen::Vector3d(v.mean[0], v.mean[1], v.mean[2]) * (options_.voxel_size / kMeanUnits);
 }
 
-std::vector<Eigen::Vector3d> VoxelObject::occupiedCentres(std::optional<double> min_probability) const {
+template <class PointOf>
+std::vector<Eigen::Vector3d> VoxelObject::pointsAtOrAbove(std::optional<double> min_probability,
+                                                          PointOf point_of) const {
   const float cut = logOddsCut(min_probability);
   std::vector<Eigen::Vector3d> out;
   out.reserve(voxels_.size());
   for (const auto& [key, v] : voxels_)
-    if (v.log_odds >= cut) out.push_back(centreOf(key));
+    if (v.log_odds >= cut) out.push_back(point_of(key, v));
   return out;
 }
 
+std::vector<Eigen::Vector3d> VoxelObject::occupiedCentres(std::optional<double> min_probability) const {
+  return pointsAtOrAbove(min_probability, [this](uint64_t key, const Voxel&) { return centreOf(key); });
+}
+
 std::vector<Eigen::Vector3d> VoxelObject::occupiedPointMeans(std::optional<double> min_probability) const {
-  const float cut = logOddsCut(min_probability);
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(voxels_.size());
-  for (const auto& [key, v] : voxels_)
-    if (v.log_odds >= cut) out.push_back(pointMeanOf(key, v));
-  return out;
+  return pointsAtOrAbove(min_probability, [this](uint64_t key, const Voxel& v) { return pointMeanOf(key, v); });
 }
 
 Eigen::AlignedBox3d VoxelObject::bounds() const {

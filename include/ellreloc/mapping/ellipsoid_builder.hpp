@@ -143,8 +143,10 @@ inline Eigen::Vector2d smallestPercentileRectangleNear(const std::vector<Eigen::
   const double t0 = std::atan2(start.y(), start.x());
   const int steps = static_cast<int>(std::ceil(reach / kStep));
   double best_t = t0, best_area = area(t0);
-  for (int i = -steps; i <= steps; ++i)
-    if (const double a = area(t0 + i * kStep); i != 0 && a < best_area) best_area = a, best_t = t0 + i * kStep;
+  for (int i = -steps; i <= steps; ++i) {
+    if (i == 0) continue;  // t0, above
+    if (const double a = area(t0 + i * kStep); a < best_area) best_area = a, best_t = t0 + i * kStep;
+  }
   const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
   double a = best_t - kStep, b = best_t + kStep;
   double c = b - ratio * (b - a), d = a + ratio * (b - a), fc = area(c), fd = area(d);

@@ -124,6 +124,9 @@ class VoxelObject {
   /// The log-odds at or above which a voxel counts, for `min_probability` (default: occupied).
   float logOddsCut(std::optional<double> min_probability) const;
   Eigen::Vector3d pointMeanOf(uint64_t key, const Voxel& v) const;
+  /// point_of(key, voxel) for each voxel at or above `min_probability` (default: occupied).
+  template <class PointOf>
+  std::vector<Eigen::Vector3d> pointsAtOrAbove(std::optional<double> min_probability, PointOf point_of) const;
   static uint64_t pack(int x, int y, int z);
   static Eigen::Vector3i unpack(uint64_t key);
   std::optional<uint64_t> keyOf(const Eigen::Vector3d& x_w) const;
