@@ -63,6 +63,10 @@ int HypothesisEstimator::generate(const int* s, Model* models) const {
   int count = 0;
   for (int i = 0; i < n; ++i) {
     Model m{poses[i], {}};
+    // The gate first: a few operations, where the correction costs a P3P and three projections.
+    // A correction moves a pose by millimetres to centimetres (accept() gates the corrected
+    // pose again); the rare one that jumps to another P3P branch is no correction of this pose.
+    if (!gate_.admits(m.pose)) continue;
     if (options_.search.correct_centres && !correctCentres(s, &m.pose)) continue;
     if (accept(m.pose, s, 3, options_.search.check_sample_overlap, &m.own)) models[count++] = m;
   }
