@@ -90,6 +90,36 @@ TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
   EXPECT_GE(recovered, tried - 1);
 }
 
+// Auto enumerates when the triplets of distinct observations are few, though the triplets of
+// candidate pairs are many: 4 observations with 6 candidates each form 864 usable triplets
+// (within max_exhaustive_triplets, 1000) among 2024 triplets of pairs. The result is then the
+// Exhaustive sampler's, every usable triplet tried.
+TEST(ObjectRelocalizer, AutoEnumeratesWhenUsableTripletsAreFew) {
+  std::mt19937 rng(86);
+  const Intrinsics K = test::testIntrinsics();
+  int checked = 0;
+  for (int trial = 0; trial < 40 && checked < 3; ++trial) {
+    const Synthetic s = makeScene(rng, 24, 4, 0.5);  // 6 objects of each of 4 categories
+    std::vector<Observation> four;
+    std::vector<char> seen(4, 0);
+    for (const Observation& o : s.observations)
+      if (!seen[static_cast<size_t>(o.category)]) seen[static_cast<size_t>(o.category)] = 1, four.push_back(o);
+    if (four.size() < 4) continue;
+    ++checked;
+    RelocalizerOptions exhaustive;
+    exhaustive.search.sampler = HypothesisSampler::Exhaustive;
+    const RelocalizationResult automatic = ObjectRelocalizer(s.map, K).relocalize(four);
+    const RelocalizationResult every = ObjectRelocalizer(s.map, K, exhaustive).relocalize(four);
+    EXPECT_EQ(automatic.iterations, 2024);
+    EXPECT_EQ(automatic.iterations, every.iterations);
+    EXPECT_EQ(automatic.hypotheses, every.hypotheses);
+    EXPECT_EQ(automatic.status, every.status);
+    EXPECT_TRUE(automatic.pose.rotation().isApprox(every.pose.rotation()));
+    EXPECT_TRUE(automatic.pose.translation().isApprox(every.pose.translation()));
+  }
+  EXPECT_EQ(checked, 3);
+}
+
 // Options out of range are refused with the field's name, before any work (a NaN cost used to
 // give Success with a NaN score).
 TEST(ObjectRelocalizer, InvalidOptionsGiveInvalidInputNamingTheField) {

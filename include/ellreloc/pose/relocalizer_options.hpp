@@ -21,7 +21,7 @@
 namespace ellreloc {
 
 enum class HypothesisSampler {
-  Auto,        ///< Exhaustive when there are at most `max_exhaustive_triplets` triplets, else Prosac
+  Auto,        ///< Exhaustive when there are at most `max_exhaustive_triplets` usable triplets, else Prosac
   Exhaustive,  ///< every triplet of candidate pairs (OA-SLAM)
   Uniform,     ///< random triplets
   Prosac,      ///< random triplets, best (detection score x object size) first
@@ -35,8 +35,10 @@ enum class OverlapMeasure {
 /// Hypotheses from triplets of (observation, map object) pairs through P3P.
 struct SearchOptions {
   HypothesisSampler sampler = HypothesisSampler::Auto;
-  long max_exhaustive_triplets = 1000;  ///< Auto enumerates every triplet up to this many
-  bool correct_centres = true;          ///< re-solve P3P with the projected-centre offset removed
+  /// Auto enumerates every triplet when there are at most this many with three distinct
+  /// observations (the triplets P3P is tried on).
+  long max_exhaustive_triplets = 1000;
+  bool correct_centres = true;  ///< re-solve P3P with the projected-centre offset removed
   /// Drop a pose when one of its own three pairs overlaps less than scoring.min_overlap: a
   /// wrong triplet rarely fits the three shapes, and this costs three overlaps, not a map.
   bool check_sample_overlap = true;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace ellreloc::pipeline {
 
@@ -19,6 +20,19 @@ double candidateShare(const Observation& o, const MapObject& m, const ScoringOpt
 }
 
 }  // namespace
+
+double usableTriplets(const std::vector<CandidatePair>& pairs) {
+  std::map<int, double> per_observation;
+  for (const CandidatePair& p : pairs) per_observation[p.observation] += 1.0;
+  // The third elementary symmetric sum of the candidate counts, built one observation at a time.
+  double singles = 0.0, twos = 0.0, threes = 0.0;
+  for (const auto& [observation, count] : per_observation) {
+    threes += twos * count;
+    twos += singles * count;
+    singles += count;
+  }
+  return threes;
+}
 
 Candidates collectCandidates(const std::vector<Observation>& observations, const ObjectMap& map,
                              const ScoringOptions& options, long max_pairs,

@@ -24,7 +24,9 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
   const int n = static_cast<int>(estimators.front()->numData());
   HypothesisSampler sampler = options.search.sampler;
   if (sampler == HypothesisSampler::Auto) {
-    const double triplets = static_cast<double>(n) * (n - 1) * (n - 2) / 6.0;
+    // What enumerating costs is the triplets of distinct observations, not all n choose 3
+    // triplets of pairs (most repeat an observation and are dropped at once).
+    const double triplets = usableTriplets(estimators.front()->pairs());
     sampler = triplets <= static_cast<double>(options.search.max_exhaustive_triplets) ? HypothesisSampler::Exhaustive
                                                                                       : HypothesisSampler::Prosac;
   }
