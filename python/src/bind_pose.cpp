@@ -138,7 +138,8 @@ bool hasPose(const RelocalizationResult& r) {
 
 void bindOptionGroups(py::module_& m) {
   py::enum_<HypothesisSampler>(m, "HypothesisSampler")
-      .value("auto", HypothesisSampler::Auto, "exhaustive up to search.max_exhaustive_triplets triplets of distinct observations, else prosac")
+      .value("auto", HypothesisSampler::Auto,
+             "exhaustive up to search.max_exhaustive_triplets triplets of distinct observations, else prosac")
       .value("exhaustive", HypothesisSampler::Exhaustive, "every triplet of candidate pairs (OA-SLAM)")
       .value("uniform", HypothesisSampler::Uniform)
       .value("prosac", HypothesisSampler::Prosac, "random triplets, best (score x size) first");
