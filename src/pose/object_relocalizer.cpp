@@ -197,7 +197,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
       helpers.emplace_back(observations, candidates, map_, K_, options_, gate, s, &pool);
       estimators.push_back(&helpers.back());
     }
-    searchTriplets(estimators, options_, budget, &pool, &search);
+    searchTriplets(estimators, candidates, options_, budget, &pool, &search);
   }
   if (few && (usable <= options_.few_objects.max_observations || search.best_inliers < 3))
     searchFewObjects(estimator, candidates, options_, gravity, budget, &pool, &search);

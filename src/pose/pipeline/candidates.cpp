@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 namespace ellreloc::pipeline {
 
@@ -21,12 +20,11 @@ double candidateShare(const Observation& o, const MapObject& m, const ScoringOpt
 
 }  // namespace
 
-double usableTriplets(const std::vector<CandidatePair>& pairs) {
-  std::map<int, double> per_observation;
-  for (const CandidatePair& p : pairs) per_observation[p.observation] += 1.0;
+double usableTriplets(const Candidates& candidates) {
   // The third elementary symmetric sum of the candidate counts, built one observation at a time.
   double singles = 0.0, twos = 0.0, threes = 0.0;
-  for (const auto& [observation, count] : per_observation) {
+  for (const std::vector<int>& objects : candidates.of_observation) {
+    const double count = static_cast<double>(objects.size());
     threes += twos * count;
     twos += singles * count;
     singles += count;

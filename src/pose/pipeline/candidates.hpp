@@ -29,7 +29,7 @@ struct Candidates {
 
 /// Triplets of pairs with three distinct observations: the triplets P3P is tried on (a triplet
 /// that repeats an object is dropped when generated). Counted, not enumerated.
-double usableTriplets(const std::vector<CandidatePair>& pairs);
+double usableTriplets(const Candidates& candidates);
 
 /// Observations that are invalid, have no candidate object, or would take the pairs beyond
 /// max_pairs go to `skipped` (in observation order) with the reason.

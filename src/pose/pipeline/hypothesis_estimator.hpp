@@ -56,7 +56,6 @@ class HypothesisEstimator {
 
   // The RANSAC estimator concept (core/ransac.hpp) over candidate pairs.
   size_t numData() const { return pairs_.size(); }
-  const std::vector<CandidatePair>& pairs() const { return pairs_; }
   /// P3P on the observed centres of three pairs, with the projected-centre correction.
   int generate(const int* sample, Model* models) const;
   /// The ranking cost (PoseScorer::cost at kRankingIoUVertices).

@@ -19,14 +19,15 @@ FrameBudget frameBudget(const SearchOptions& search, size_t num_objects, int num
   return budget;
 }
 
-void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, const RelocalizerOptions& options,
-                    const FrameBudget& frame, HypothesisPool* pool, SearchOutcome* outcome) {
+void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, const Candidates& candidates,
+                    const RelocalizerOptions& options, const FrameBudget& frame, HypothesisPool* pool,
+                    SearchOutcome* outcome) {
   const int n = static_cast<int>(estimators.front()->numData());
   HypothesisSampler sampler = options.search.sampler;
   if (sampler == HypothesisSampler::Auto) {
     // What enumerating costs is the triplets of distinct observations, not all n choose 3
     // triplets of pairs (most repeat an observation and are dropped at once).
-    const double triplets = usableTriplets(estimators.front()->pairs());
+    const double triplets = usableTriplets(candidates);
     sampler = triplets <= static_cast<double>(options.search.max_exhaustive_triplets) ? HypothesisSampler::Exhaustive
                                                                                       : HypothesisSampler::Prosac;
   }

@@ -40,10 +40,12 @@ struct FrameBudget {
 FrameBudget frameBudget(const SearchOptions& search, size_t num_objects, int num_usable,
                         std::chrono::steady_clock::time_point start);
 
-/// RANSAC over triplets of candidate pairs with the sampler of options.search, within `budget`,
-/// on one thread per estimator (equivalent estimators, each with its own scorer).
-void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, const RelocalizerOptions& options,
-                    const FrameBudget& budget, HypothesisPool* pool, SearchOutcome* outcome);
+/// RANSAC over triplets of `candidates`' pairs with the sampler of options.search, within
+/// `budget`, on one thread per estimator (equivalent estimators over those candidates, each with
+/// its own scorer).
+void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, const Candidates& candidates,
+                    const RelocalizerOptions& options, const FrameBudget& budget, HypothesisPool* pool,
+                    SearchOutcome* outcome);
 
 /// The two-object solver on pairs of candidate pairs, and with gravity and a single usable
 /// observation, the one-object solver: up to few_objects.max_pair_hypotheses solver calls, and
