@@ -1,4 +1,5 @@
-"""Rewrites the generated regions of docs/benchmarks.md from one scripts/benchmarks.sh run.
+"""Rewrites the generated regions of a document (docs/benchmarks.md, docs/reliability.md) from
+one scripts/benchmarks.sh run.
 
 A region is the text between `<!-- bench:NAME -->` and `<!-- /bench:NAME -->`; NAME is a result
 in the results folder: NAME.json (Google Benchmark, medians shown) or NAME.txt (an accuracy

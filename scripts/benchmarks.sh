@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the benchmarks, runs them all, and rewrites the generated tables of docs/benchmarks.md
-# from this one run (each between <!-- bench:NAME --> and <!-- /bench:NAME -->, stamped with the
-# date, the core count and the command). Raw outputs stay in $ELLRELOC_BUILD_DIR/bench-results.
+# and docs/reliability.md from this one run (each between <!-- bench:NAME --> and
+# <!-- /bench:NAME -->, stamped with the date, the core count and the command). Raw outputs stay
+# in $ELLRELOC_BUILD_DIR/bench-results.
 #   scripts/benchmarks.sh           the full set (about 20 minutes on 2 cores)
 #   scripts/benchmarks.sh --quick   fewer repetitions and seeds, no exhaustive baseline on the cluttered scene
 set -euo pipefail
@@ -47,6 +48,7 @@ else
 fi
 table real_data python3 scripts/real_data.py "$build"
 table fr3_splits python3 scripts/fr3_splits.py "$build"
+table null_frames python3 scripts/null_frames.py "$build"
 table observe_accuracy "$bin/observe_accuracy"
 table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
 # Observations, voxel maps and relocalization on the independent renderer's scene and on two
@@ -69,4 +71,5 @@ fi
 scripts/doc_images.sh "$build"
 
 python3 scripts/benchmark_tables.py "$out" docs/benchmarks.md "$(nproc)"
-echo "benchmarks: docs/benchmarks.md rewritten from $out" >&2
+python3 scripts/benchmark_tables.py "$out" docs/reliability.md "$(nproc)"
+echo "benchmarks: docs/benchmarks.md and docs/reliability.md rewritten from $out" >&2

@@ -32,7 +32,10 @@ cli = os.path.join(build, "apps", "ellreloc", "ellreloc")
 
 
 def run(*args):
-    return subprocess.run([cli, *args], check=True, capture_output=True, text=True).stdout
+    done = subprocess.run([cli, *args], capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit("%s %s failed: %s" % (cli, args[0], done.stderr.strip()))
+    return done.stdout
 
 
 def relocalize(camera, map_path, detections, groundtruth, method, work, extra=()):
