@@ -6,19 +6,16 @@
 /// onto the ground plane (the paper: the main axis of their PCA, which YawMethod::Pca keeps);
 /// extents along the two ground axes and gravity come from robust percentiles of the point
 /// coordinates; the ellipsoid is the one inscribed in that
-/// cuboid (eqs. 5-6: Q* = Z^T diag(l^2/4, w^2/4, h^2/4, -1) Z).
+/// cuboid (eqs. 5-6: Q* = Z^T diag(l^2/4, w^2/4, h^2/4, -1) Z). Compiled in
+/// src/mapping/ellipsoid_builder.cpp.
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <optional>
 #include <vector>
 
 #include "ellreloc/core/ellipsoid.hpp"
-#include "ellreloc/core/statistics.hpp"
 
 namespace ellreloc {
 
@@ -71,98 +68,9 @@ struct BuiltEllipsoid {
 };
 
 namespace detail {
-/// The percentile rectangle of ground-plane points along `main` and across it (lo, hi in
-/// (along, across) coordinates); `along` and `across` receive every point's coordinates.
-inline void percentileRectangle(const std::vector<Eigen::Vector2d>& ground, const Eigen::Vector2d& main, double low,
-                                double high, std::vector<double>* along, std::vector<double>* across,
-                                Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
-  const Eigen::Vector2d side(-main.y(), main.x());
-  along->resize(ground.size());
-  across->resize(ground.size());
-  for (size_t i = 0; i < ground.size(); ++i) (*along)[i] = main.dot(ground[i]), (*across)[i] = side.dot(ground[i]);
-  *lo = Eigen::Vector2d(interpolatedQuantile(*along, low), interpolatedQuantile(*across, low));
-  *hi = Eigen::Vector2d(interpolatedQuantile(*along, high), interpolatedQuantile(*across, high));
-}
 /// The direction of the longer side of the smallest-area rectangle enclosing 2D points: the
 /// rectangle has a side on an edge of the convex hull, so each hull edge is tried.
-inline std::optional<Eigen::Vector2d> minAreaRectangleAxis(std::vector<Eigen::Vector2d> p) {
-  std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
-  if (p.size() < 3) return std::nullopt;
-  const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
-  };
-  std::vector<Eigen::Vector2d> hull(2 * p.size());  // Andrew's monotone chain
-  size_t k = 0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
-    hull[k++] = p[i];
-  }
-  for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
-    while (k >= t && cross(hull[k - 2], hull[k - 1], p[i - 1]) <= 0) --k;
-    hull[k++] = p[i - 1];
-  }
-  hull.resize(k - 1);
-  if (hull.size() < 3) return std::nullopt;
-  double best_area = std::numeric_limits<double>::infinity();
-  Eigen::Vector2d best = Eigen::Vector2d::UnitX();
-  for (size_t i = 0; i < hull.size(); ++i) {
-    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
-    if (!(e.norm() > 0.0)) continue;
-    const Eigen::Vector2d u = e.normalized(), v(-u.y(), u.x());
-    double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
-    for (const Eigen::Vector2d& q : hull) {
-      u_lo = std::min(u_lo, u.dot(q)), u_hi = std::max(u_hi, u.dot(q));
-      v_lo = std::min(v_lo, v.dot(q)), v_hi = std::max(v_hi, v.dot(q));
-    }
-    const double area = (u_hi - u_lo) * (v_hi - v_lo);
-    if (area < best_area) best_area = area, best = (u_hi - u_lo) >= (v_hi - v_lo) ? u : v;
-  }
-  return best;
-}
-
-/// The direction of the longer side of the smallest percentile rectangle of 2D points (the
-/// rectangle percentileRectangle() gives, the extents the cuboid takes) within `reach` radians
-/// of `start`: a sweep in 1 degree steps, then a golden-section search around its best. At most
-/// `max_points` points (every k-th) are used: it runs at each update of an object.
-inline Eigen::Vector2d smallestPercentileRectangleNear(const std::vector<Eigen::Vector2d>& points,
-                                                       const Eigen::Vector2d& start, double reach, double low,
-                                                       double high, size_t max_points) {
-  const size_t stride = std::max<size_t>(1, (points.size() + max_points - 1) / max_points);
-  std::vector<Eigen::Vector2d> p;
-  for (size_t i = 0; i < points.size(); i += stride) p.push_back(points[i]);
-  std::vector<double> along, across;
-  Eigen::Vector2d lo, hi;
-  const auto direction = [](double t) { return Eigen::Vector2d(std::cos(t), std::sin(t)); };
-  const auto area = [&](double t) {
-    percentileRectangle(p, direction(t), low, high, &along, &across, &lo, &hi);
-    return (hi - lo).prod();
-  };
-  constexpr double kStep = M_PI / 180.0;
-  const double t0 = std::atan2(start.y(), start.x());
-  const int steps = static_cast<int>(std::ceil(reach / kStep));
-  double best_t = t0, best_area = area(t0);
-  for (int i = -steps; i <= steps; ++i) {
-    if (i == 0) continue;  // t0, above
-    if (const double a = area(t0 + i * kStep); a < best_area) best_area = a, best_t = t0 + i * kStep;
-  }
-  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
-  double a = best_t - kStep, b = best_t + kStep;
-  double c = b - ratio * (b - a), d = a + ratio * (b - a), fc = area(c), fd = area(d);
-  while (b - a > 1e-6) {
-    if (fc < fd) {
-      b = d, d = c, fd = fc, c = b - ratio * (b - a), fc = area(c);
-    } else {
-      a = c, c = d, fc = fd, d = a + ratio * (b - a), fd = area(d);
-    }
-  }
-  const double t = std::min(fc, fd) < best_area ? 0.5 * (a + b) : best_t;
-  percentileRectangle(p, direction(t), low, high, &along, &across, &lo, &hi);
-  const Eigen::Vector2d u = direction(t);
-  return (hi - lo).x() >= (hi - lo).y() ? u : Eigen::Vector2d(-u.y(), u.x());
-}
-
+std::optional<Eigen::Vector2d> minAreaRectangleAxis(std::vector<Eigen::Vector2d> p);
 }  // namespace detail
 
 /// A right-handed world basis (e1, e2, up) with e1, e2 spanning the ground plane.
@@ -178,77 +86,7 @@ inline Eigen::Matrix3d groundBasis(const Eigen::Vector3d& up) {
 /// Builds the yaw-only cuboid and its inscribed ellipsoid from an object's points
 /// (world coordinates). nullopt with fewer than options.min_points points, a zero or
 /// non-finite `up`, or a degenerate (flat) point set.
-inline std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vector3d>& points,
-                                                    const EllipsoidBuilderOptions& options = {}) {
-  if (points.size() < std::max<size_t>(options.min_points, 4) || !options.up.allFinite() ||
-      !(options.up.norm() > 1e-12))
-    return std::nullopt;
-  const Eigen::Matrix3d B = groundBasis(options.up);
-
-  // PCA of the ground-plane projections: the main axis gives the yaw. PCA weighs far points
-  // heavily, so it runs twice: on all points, then on those inside the percentile cuboid of
-  // the first pass (a trimmed PCA).
-  std::vector<Eigen::Vector2d> ground(points.size());
-  std::vector<double> heights(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    ground[i] = B.leftCols<2>().transpose() * points[i];
-    heights[i] = B.col(2).dot(points[i]);
-  }
-  std::vector<char> inlier(points.size(), 1);
-  Eigen::Vector2d main, lo, hi;
-  std::vector<double> along, across;
-  for (int pass = 0; pass < 2; ++pass) {
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    double n = 0.0;
-    for (size_t i = 0; i < ground.size(); ++i)
-      if (inlier[i]) mean += ground[i], n += 1.0;
-    if (n < 4.0) return std::nullopt;
-    mean /= n;
-    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-    for (size_t i = 0; i < ground.size(); ++i)
-      if (inlier[i]) cov += (ground[i] - mean) * (ground[i] - mean).transpose();
-    if (!cov.allFinite()) return std::nullopt;
-    main = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvectors().col(1);  // largest eigenvalue
-    detail::percentileRectangle(ground, main, options.low_percentile, options.high_percentile, &along, &across, &lo,
-                                &hi);
-    for (size_t i = 0; i < ground.size(); ++i)
-      inlier[i] = along[i] >= lo.x() && along[i] <= hi.x() && across[i] >= lo.y() && across[i] <= hi.y();
-  }
-  if (options.yaw == YawMethod::MinAreaRectangle) {
-    std::vector<Eigen::Vector2d> footprint;
-    for (size_t i = 0; i < ground.size(); ++i)
-      if (inlier[i]) footprint.push_back(ground[i]);
-    const auto axis = detail::minAreaRectangleAxis(footprint);
-    if (!axis) return std::nullopt;
-    // The hull's rectangle rests on the outermost points, which a few stray voxels set; the
-    // yaw is polished to the smallest percentile rectangle within 4 degrees of it. A wider
-    // search can fall to the diagonal of a box seen on two faces only (an L-shaped footprint),
-    // whose percentile rectangle is as small as the true one.
-    main = detail::smallestPercentileRectangleNear(footprint, *axis, 4.0 * M_PI / 180.0, options.low_percentile,
-                                                   options.high_percentile, 512);
-    detail::percentileRectangle(ground, main, options.low_percentile, options.high_percentile, &along, &across, &lo,
-                                &hi);
-  }
-  const double yaw = std::atan2(main.y(), main.x());
-
-  Cuboid cuboid;  // axes: the main ground axis, the other ground axis, up
-  cuboid.rotation.col(0) = B.leftCols<2>() * main;
-  cuboid.rotation.col(2) = B.col(2);
-  cuboid.rotation.col(1) = cuboid.rotation.col(2).cross(cuboid.rotation.col(0));
-  const double h_lo = interpolatedQuantile(heights, options.low_percentile);
-  const double h_hi = interpolatedQuantile(heights, options.high_percentile);
-  const Eigen::Vector3d local_lo(lo.x(), lo.y(), h_lo), local_hi(hi.x(), hi.y(), h_hi);
-  // The second pass's percentiles are of all points in its final frame: outliers stay out.
-  cuboid.half = 0.5 * (local_hi - local_lo) + Eigen::Vector3d::Constant(options.extent_padding);
-  const Eigen::Vector3d local_center = 0.5 * (local_lo + local_hi);
-  // local coordinates are (main, side, up) in the basis B; side = up x main matches col(1).
-  if (!(cuboid.half.minCoeff() > 0.0) || !cuboid.half.allFinite()) return std::nullopt;
-  cuboid.center = cuboid.rotation * local_center;
-  BuiltEllipsoid out;
-  out.cuboid = cuboid;
-  out.ellipsoid = cuboid.inscribedEllipsoid();
-  out.yaw = yaw;
-  return out;
-}
+std::optional<BuiltEllipsoid> buildEllipsoid(const std::vector<Eigen::Vector3d>& points,
+                                             const EllipsoidBuilderOptions& options = {});
 
 }  // namespace ellreloc
