@@ -325,7 +325,11 @@ TEST(ObjectRelocalizer, OneFrameOnThreadsGivesTheSerialResultThreadSafe) {
       const Synthetic s = makeScene(rng, objects, 3, 1.0);
       if (s.observations.size() < 4) continue;
       RelocalizerOptions options = preset ? RelocalizerOptions::oaSlam() : RelocalizerOptions();
+      // The preset's exhaustive search of 30 objects would try 222,000 hypotheses: a budget
+      // keeps the test short and checks that a split search stops where the serial one does.
+      if (preset) options.search.budget.max_hypotheses = 20000;
       const RelocalizationResult serial = ObjectRelocalizer(s.map, K, options).relocalize(s.observations);
+      if (preset && objects == 30) EXPECT_TRUE(serial.budget_exhausted);
       for (int threads : {2, 3}) {
         options.search.threads = threads;
         const RelocalizationResult split = ObjectRelocalizer(s.map, K, options).relocalize(s.observations);
@@ -336,6 +340,7 @@ TEST(ObjectRelocalizer, OneFrameOnThreadsGivesTheSerialResultThreadSafe) {
         EXPECT_EQ(split.pose.translation(), serial.pose.translation());
         EXPECT_EQ(split.hypotheses, serial.hypotheses);
         EXPECT_EQ(split.iterations, serial.iterations);
+        EXPECT_EQ(split.budget_exhausted, serial.budget_exhausted);
         EXPECT_EQ(split.inliers.size(), serial.inliers.size());
         EXPECT_EQ(split.cost, serial.cost);
       }
