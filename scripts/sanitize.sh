@@ -13,23 +13,27 @@ jobs="$(nproc)"
 # No Python bindings: an instrumented extension needs the sanitizer runtime preloaded into python.
 common=(-G Ninja -DCMAKE_BUILD_TYPE= -DELLRELOC_BUILD_BENCHMARKS=OFF -DELLRELOC_PYTHON=OFF)
 export CC=clang-14 CXX=clang++-14
+start=$SECONDS
 
 if [ "$what" = asan ] || [ "$what" = all ]; then
   cmake -S . -B build-asan "${common[@]}" -DELLRELOC_BUILD_FUZZERS=ON \
     -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer" \
     >/dev/null
   cmake --build build-asan -j "$jobs"
+  echo "sanitize: asan build done after $((SECONDS - start)) s"
   # Left out: the packaging test (installs and rebuilds the examples: nothing to sanitize) and
   # the real-data regressions (fr2_desk: 198 relocalizations, 90 s under ASan; fr3: a 646-frame
   # box map; the CLI paths they take are covered by the other CLI tests).
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j "$jobs" -E "packaging.consumer|Cli.Fr2Desk|Cli.Fr3Boxes|Acceptance.NoPose"
+  echo "sanitize: asan tests done after $((SECONDS - start)) s"
 fi
 
 if [ "$what" = tsan ] || [ "$what" = all ]; then
   cmake -S . -B build-tsan "${common[@]}" -DELLRELOC_BUILD_EXAMPLES=OFF \
     -DCMAKE_CXX_FLAGS="-O1 -fsanitize=thread" >/dev/null
   cmake --build build-tsan -j "$jobs" --target pose_tests mapping_tests
+  echo "sanitize: tsan build done after $((SECONDS - start)) s"
   # One relocalizer shared by 8 threads, and a mapper read while it maps: same answers as serial.
   TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/pose_tests --gtest_filter='*ThreadSafe*'
   TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/mapping_tests --gtest_filter='*ReadsWhileMapping*'
