@@ -4,6 +4,7 @@
 /// toothbrush 79): for people reading summaries and pictures.
 
 #include <array>
+#include <cstddef>
 
 namespace ellreloc {
 
