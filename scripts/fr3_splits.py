@@ -45,10 +45,7 @@ def main():
     totals = [0.0, 0.0, 0.0, 0.0]
     with tempfile.TemporaryDirectory() as work:
         for k, (name, mapping, query) in enumerate(splits(frames)):
-            mapping_path, query_path = os.path.join(work, "%d.map_frames.json" % k), os.path.join(work, "%d.q.json" % k)
-            json.dump(mapping, open(mapping_path, "w"))
-            json.dump(query, open(query_path, "w"))
-            map_path, what = box_map(camera, groundtruth, mapping_path, query_path, work, str(k))
+            map_path, query_path, what = box_map(camera, groundtruth, mapping, query, work, str(k))
             valid = [float(relocalize(camera, map_path, query_path, groundtruth, method, work, extra)["valid"])
                      for method, extra in (("ours", ()), ("ours", ("--accept-all",)), ("oa-slam", ()))]
             quality = float(what.split("IoU ")[1])

@@ -23,7 +23,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from real_data import box_map, data, run  # noqa: E402  (same arguments as real_data.py)
+from real_data import box_map, data, run, table_splits  # noqa: E402  (same arguments as real_data.py)
 
 
 def moved_boxes(frames, width, height, seed):
@@ -70,16 +70,11 @@ def main():
         fr2_cam, fr3_cam, s11_cam = (os.path.join(d, "camera.yaml") for d in (fr2, fr3, s11))
         fr2_frames = json.load(open(os.path.join(fr2, "keyframes.detections.json")))
         s11_frames = json.load(open(os.path.join(s11, "query.detections.json")))
-        fr3_all = json.load(open(os.path.join(fr3, "detections.json")))
-        cut = int(0.6 * len(fr3_all))
-        fr3_odd, fr3_rest = fr3_all[1::2], fr3_all[cut::5]
+        splits = table_splits(json.load(open(os.path.join(fr3, "detections.json"))))
+        fr3_odd, fr3_rest = splits["fr3 even/odd"][1], splits["fr3 60/40"][1]
         maps = {"fr2": os.path.join(fr2, "map.json"), "s11": os.path.join(s11, "map_noisy.json")}
-        for name, mapping, holdout in (("fr3_even", fr3_all[0::2], fr3_odd), ("fr3_60", fr3_all[:cut], fr3_rest)):
-            frames_path, holdout_path = os.path.join(work, name + ".frames.json"), os.path.join(work, name + ".q.json")
-            json.dump(mapping, open(frames_path, "w"))
-            json.dump(holdout, open(holdout_path, "w"))
-            maps[name] = box_map(fr3_cam, os.path.join(fr3, "groundtruth.txt"), frames_path, holdout_path, work,
-                                 name)[0]
+        for name, split in (("fr3_even", "fr3 even/odd"), ("fr3_60", "fr3 60/40")):
+            maps[name] = box_map(fr3_cam, os.path.join(fr3, "groundtruth.txt"), *splits[split], work, name)[0]
 
         def moved(frames, camera, seed):
             return moved_boxes(frames, *image_size(camera), seed)

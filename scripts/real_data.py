@@ -52,13 +52,23 @@ def relocalize(camera, map_path, detections, groundtruth, method, work, extra=()
     return {"valid": valid, "pos": pos, "rot": rot, "ms": ms, "diagnosis": diagnosis, "wrong": wrong}
 
 
-def box_map(camera, trajectory, frames, holdout, work, name):
-    path = os.path.join(work, name + ".map.json")
-    printed = run("map", "--camera", camera, "--trajectory", trajectory, "--detections", frames, "--mode", "boxes",
-                  "--out", path, "--holdout", holdout)
+def box_map(camera, trajectory, mapping, query, work, name):
+    """`ellreloc map --mode boxes` on the frames `mapping`, its quality measured on the frames
+    `query`: (map path, query detections path, "N objects, held-out IoU Q")."""
+    mapping_path, query_path, path = (os.path.join(work, name + s) for s in (".map_frames.json", ".q.json", ".map.json"))
+    json.dump(mapping, open(mapping_path, "w"))
+    json.dump(query, open(query_path, "w"))
+    printed = run("map", "--camera", camera, "--trajectory", trajectory, "--detections", mapping_path, "--mode",
+                  "boxes", "--out", path, "--holdout", query_path)
     objects = int(re.search(r": (\d+) objects", printed).group(1))
     quality = float(re.search(r"IoU ([0-9.]+)", printed).group(1))
-    return path, "%d objects, held-out IoU %.2f" % (objects, quality)
+    return path, query_path, "%d objects, held-out IoU %.2f" % (objects, quality)
+
+
+def table_splits(frames):
+    """The fr3 splits of this table: name -> (mapping frames, query frames)."""
+    cut = int(0.6 * len(frames))
+    return {"fr3 60/40": (frames[:cut], frames[cut::5]), "fr3 even/odd": (frames[0::2], frames[1::2])}
 
 
 def main():
@@ -72,14 +82,9 @@ def main():
         fr3 = os.path.join(data, "tum_fr3_office_first_half")
         camera, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
         frames = json.load(open(os.path.join(fr3, "detections.json")))
-        cut = int(0.6 * len(frames))
-        splits = {"fr3 60/40": (frames[:cut], frames[cut::5]), "fr3 even/odd": (frames[0::2], frames[1::2])}
-        for name, (mapping, query) in splits.items():
+        for name, (mapping, query) in table_splits(frames).items():
             tag = name.replace(" ", "_").replace("/", "_")
-            mapping_path, query_path = os.path.join(work, tag + ".map_frames.json"), os.path.join(work, tag + ".q.json")
-            json.dump(mapping, open(mapping_path, "w"))
-            json.dump(query, open(query_path, "w"))
-            map_path, what = box_map(camera, groundtruth, mapping_path, query_path, work, tag)
+            map_path, query_path, what = box_map(camera, groundtruth, mapping, query, work, tag)
             rows.append((name, "boxes map: " + what, camera, map_path, query_path, groundtruth,
                          ("ours without the map's envelope", ["--no-map-envelope"])))
         s11 = os.path.join(data, "independent_synth", "office_s11")

@@ -34,9 +34,10 @@ double iouRaster(const Ellipse& a, const Ellipse& b, int n) {
   const Box ba = a.boundingBox(), bb = b.boundingBox();
   const Box u(std::min(ba.x1, bb.x1), std::min(ba.y1, bb.y1), std::max(ba.x2, bb.x2), std::max(ba.y2, bb.y2));
   const double dx = u.width() / n, dy = u.height() / n;
-  // The chord [lo, hi] of an ellipse on the row at height y (empty when lo > hi).
-  const auto chord = [](const Ellipse& e, double y, double* lo, double* hi) {
-    const Eigen::Matrix2d I = e.covariance().inverse();
+  const Eigen::Matrix2d Ia = a.covariance().inverse(), Ib = b.covariance().inverse();
+  // The chord [lo, hi] of an ellipse (inverse covariance I) on the row at height y (empty when
+  // lo > hi).
+  const auto chord = [](const Ellipse& e, const Eigen::Matrix2d& I, double y, double* lo, double* hi) {
     const double v = y - e.center().y();
     const double disc = (I(0, 1) * v) * (I(0, 1) * v) - I(0, 0) * (I(1, 1) * v * v - 1.0);
     if (disc < 0.0) return *lo = 1.0, *hi = 0.0, void();
@@ -54,8 +55,8 @@ double iouRaster(const Ellipse& a, const Ellipse& b, int n) {
   for (int j = 0; j < n; ++j) {
     const double y = u.y1 + (j + 0.5) * dy;
     double a_lo, a_hi, b_lo, b_hi;
-    chord(a, y, &a_lo, &a_hi);
-    chord(b, y, &b_lo, &b_hi);
+    chord(a, Ia, y, &a_lo, &a_hi);
+    chord(b, Ib, y, &b_lo, &b_hi);
     const long both = centres(std::max(a_lo, b_lo), std::min(a_hi, b_hi));
     inter += both;
     uni += centres(a_lo, a_hi) + centres(b_lo, b_hi) - both;
