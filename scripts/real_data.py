@@ -29,6 +29,10 @@ import tempfile
 build = sys.argv[1] if len(sys.argv) > 1 else "build"
 data = sys.argv[2] if len(sys.argv) > 2 else "../shared/data"
 cli = os.path.join(build, "apps", "ellreloc", "ellreloc")
+if not os.access(cli, os.X_OK):
+    sys.exit("%s: no ellreloc command at %s (build first: scripts/build.sh)" % (sys.argv[0], cli))
+if not os.path.isdir(os.path.join(data, "tum_fr2_desk")):
+    sys.exit("%s: %s is not the shared data folder (no tum_fr2_desk in it)" % (sys.argv[0], data))
 
 
 def run(*args):
