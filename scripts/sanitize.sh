@@ -32,9 +32,8 @@ fi
 if [ "$what" = tsan ] || [ "$what" = all ]; then
   cmake -S . -B build-tsan "${common[@]}" -DELLRELOC_BUILD_EXAMPLES=OFF \
     -DCMAKE_CXX_FLAGS="-O1 -fsanitize=thread" >/dev/null
-  cmake --build build-tsan -j "$jobs" --target pose_tests mapping_tests
+  cmake --build build-tsan -j "$jobs" --target concurrency_tests
   echo "sanitize: tsan build done after $((SECONDS - start)) s"
   # One relocalizer shared by 8 threads, and a mapper read while it maps: same answers as serial.
-  TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/pose_tests --gtest_filter='*ThreadSafe*'
-  TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/mapping_tests --gtest_filter='*ReadsWhileMapping*'
+  TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/concurrency_tests --gtest_filter='*ThreadSafe*:*ReadsWhileMapping*'
 fi
