@@ -15,7 +15,10 @@ Maps built by `ellreloc map` (the fr3 rows) record where their keyframes were ta
 keeps the camera within those heights and tilts (the map's camera envelope); "ours without the
 map's envelope" (`--no-map-envelope`) does not. The GOReloc map of fr2_desk has none: "ours +
 envelope" gives it one from the keyframes' own poses (`--envelope`; they are the map's keyframes
-and the queries, so read that row as an upper bound), up from their image-up.
+and the queries, so read that row as an upper bound), up from their image-up. "upright camera"
+gives only the map's up direction (`--map-up`; the GOReloc map's frame is its first keyframe's
+camera, so about -y; office_s11's world is z-up) and keeps the camera's image-up within 90
+degrees of it at any height (`--max-tilt 90`): a camera that is never upside down.
 
 Usage: scripts/real_data.py [BUILD_DIR] [DATA_DIR]   (prints a Markdown table)
 """
@@ -82,7 +85,9 @@ def main():
         rows.append(("fr2_desk keyframes", "GOReloc map, 47 objects", os.path.join(fr2, "camera.yaml"),
                      os.path.join(fr2, "map.json"), os.path.join(fr2, "keyframes.detections.json"),
                      os.path.join(fr2, "keyframes.groundtruth.txt"),
-                     ("ours + envelope", ["--envelope", os.path.join(fr2, "keyframes.groundtruth.txt")])))
+                     [("ours + envelope", ["--envelope", os.path.join(fr2, "keyframes.groundtruth.txt")]),
+                      ("ours, upright camera (--map-up 0,-1,0 --max-tilt 90)", ["--map-up", "0,-1,0", "--max-tilt", "90"]),
+                      ("ours, upright camera, every pose", ["--map-up", "0,-1,0", "--max-tilt", "90", "--accept-all"])]))
         fr3 = os.path.join(data, "tum_fr3_office_first_half")
         camera, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
         frames = json.load(open(os.path.join(fr3, "detections.json")))
@@ -90,20 +95,19 @@ def main():
             tag = name.replace(" ", "_").replace("/", "_")
             map_path, query_path, what = box_map(camera, groundtruth, mapping, query, work, tag)
             rows.append((name, "boxes map: " + what, camera, map_path, query_path, groundtruth,
-                         ("ours without the map's envelope", ["--no-map-envelope"])))
+                         [("ours without the map's envelope", ["--no-map-envelope"])]))
         s11 = os.path.join(data, "independent_synth", "office_s11")
         rows.append(("office_s11 (independent renderer)", "its noisy map", os.path.join(s11, "camera.yaml"),
                      os.path.join(s11, "map_noisy.json"), os.path.join(s11, "query.detections.json"),
-                     os.path.join(s11, "query.groundtruth.txt"), None))
+                     os.path.join(s11, "query.groundtruth.txt"),
+                     [("ours, upright camera (--map-up 0,0,1 --max-tilt 90)", ["--map-up", "0,0,1", "--max-tilt", "90"])]))
 
         print("| data | map | method | valid | wrong poses | median pos | median rot | median time | lost frames: "
               "no pose / search / scoring failure |")
         print("|---|---|---|---|---|---|---|---|---|")
-        for name, what, camera, map_path, detections, groundtruth, variant in rows:
-            runs = [("ours", "ours", ()), ("ours", "ours, every pose (--accept-all)", ("--accept-all",)),
-                    ("oa-slam", "oa-slam preset", ())]
-            if variant:
-                runs.insert(1, ("ours", variant[0], variant[1]))
+        for name, what, camera, map_path, detections, groundtruth, variants in rows:
+            runs = [("ours", "ours", ())] + [("ours", label, extra) for label, extra in variants] + \
+                   [("ours", "ours, every pose (--accept-all)", ("--accept-all",)), ("oa-slam", "oa-slam preset", ())]
             for method, label, extra in runs:
                 r = relocalize(camera, map_path, detections, groundtruth, method, work, extra)
                 d = r["diagnosis"]

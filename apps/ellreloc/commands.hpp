@@ -68,13 +68,16 @@ struct RelocalizeArgs {
   std::string reference;         ///< TUM poses to diagnose each frame against (search or scoring failure)
   std::string envelope;          ///< TUM trajectory of the mapping keyframes: poses outside their envelope are dropped
   bool no_map_envelope = false;  ///< ignore the map's own camera envelope
+  double max_tilt_deg = -1.0;    ///< with map_up: the camera's image-up within this of up (< 0: not given)
   bool use_points = false;       ///< refine with the frames' keypoints matched to the map's points
   std::string points;            ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;
   double max_time_ms = 0.0;  ///< wall-clock budget of each frame's search; 0: none
   double min_evidence = AcceptanceOptions().min_evidence;
   bool accept_all = false;
-  std::vector<double> camera_up, map_up;  ///< a gravity prior for every frame, when both are given
+  /// A gravity prior for every frame when both are given; map_up is also the up of --envelope and
+  /// --max-tilt.
+  std::vector<double> camera_up, map_up;
   double gravity_sigma_deg = 2.0;
   std::string overlays;  ///< a folder for one PNG per frame (io/overlay.hpp); empty: none
 };

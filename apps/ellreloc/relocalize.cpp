@@ -47,8 +47,9 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
                 "map's own camera_envelope (maps built by ellreloc map record one) keeps the camera where the map "
                 "was made")
       ->check(CLI::ExistingFile);
-  r->add_flag("--no-map-envelope", a.no_map_envelope,
-              "ignore the map's camera_envelope: poses anywhere (the oa-slam method always does)");
+  auto* no_map_envelope = r->add_flag("--no-map-envelope", a.no_map_envelope,
+                                      "ignore the map's camera_envelope: poses anywhere (the oa-slam method always "
+                                      "does)");
   r->add_option("--points", a.points,
                 "refine with keypoints matched to the map's points: from this file (same frame "
                 "layout), or from the detections file when no file is given")
@@ -82,6 +83,13 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
           ->expected(3)
           ->delimiter(',');
   camera_up->needs(map_up);
+  r->add_option("--max-tilt", a.max_tilt_deg,
+                "with --map-up and no mapping poses: the camera's image-up stays within this many degrees of the "
+                "map's up, at any height (90: never upside down); replaces the map's camera_envelope")
+      ->check(CLI::Range(0.0, 180.0))
+      ->needs(map_up)
+      ->excludes("--envelope")
+      ->excludes(no_map_envelope);
   r->add_option("--gravity-sigma", a.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
       ->capture_default_str()
       ->needs(camera_up);
@@ -161,7 +169,8 @@ std::string diagnose(const RelocalizationResult& result, const ReferenceScore& r
   return best < result.cost ? "search failure" : "scoring failure";
 }
 
-/// The options of --method, --max-time-ms, --envelope and --no-map-envelope; `policy` gets the method's default.
+/// The options of --method, --max-time-ms, --envelope, --max-tilt and --no-map-envelope; `policy`
+/// gets the method's default.
 RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* policy_out) {
   RelocalizerOptions options;
   if (a.method == "oa-slam") {
@@ -186,6 +195,11 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
     if (a.map_up.size() == 3) up = Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]);
     options.envelope = CameraEnvelope::fromKeyframes(keyframes, up);
     if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
+  }
+  if (std::isnan(a.max_tilt_deg)) throw Error("--max-tilt: expected a number of degrees, not NaN");
+  if (a.max_tilt_deg >= 0.0) {
+    options.envelope = CameraEnvelope::upright(Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]), a.max_tilt_deg);
+    if (!options.envelope) throw Error("--max-tilt/--map-up: expected a finite, non-zero up and a tilt in (0, 180]");
   }
   if (const std::string problem = options.validate(); !problem.empty()) throw Error("options: " + problem);
   return options;

@@ -258,6 +258,15 @@ void bindPriors(py::module_& m) {
           },
           py::arg("keyframes"), py::arg("up") = py::none(), py::arg("height_margin") = 0.5,
           py::arg("tilt_margin_deg") = 20.0, "The envelope of mapping keyframes, widened by the margins.")
+      .def_static(
+          "upright",
+          [](const py::handle& up, double max_tilt_deg) {
+            auto e = CameraEnvelope::upright(vector<3>(up, "up"), max_tilt_deg);
+            if (!e) badArgument("upright", "needs a finite, non-zero up and max_tilt_deg in (0, 180]");
+            return *e;
+          },
+          py::arg("up"), py::arg("max_tilt_deg") = 90.0,
+          "A camera at any height whose image-up stays within max_tilt_deg of `up` (90: never upside down).")
       .def_property_readonly("up", [](const CameraEnvelope& e) { return toArray(e.up); })
       .def_readonly("min_height", &CameraEnvelope::min_height)
       .def_readonly("max_height", &CameraEnvelope::max_height)

@@ -142,6 +142,13 @@ def test_results_and_envelope(fr2, data_dir):
     high = E.Pose.from_T_wc(raised)
     assert not envelope.admits(high) and envelope.min_height < envelope.max_height
     assert 0 <= envelope.min_tilt_deg < envelope.max_tilt_deg <= 180
+    upright = E.CameraEnvelope.upright([0, -2, 0])  # the fr2 map's frame: the first keyframe's camera
+    assert upright.up.tolist() == [0, -1, 0] and upright.max_tilt_deg == 90 and upright.admits(high)
+    assert all(upright.admits(p.pose) for p in truth)
+    with pytest.raises(ValueError):
+        E.CameraEnvelope.upright([0, 0, 0])
+    with pytest.raises(ValueError):
+        E.CameraEnvelope.upright([0, 0, 1], 0)
     relocalizer = E.ObjectRelocalizer(map_, camera, envelope=envelope)
     r = relocalizer.relocalize(frames[0])
     assert isinstance(r, E.RelocalizationResult) and r.success and r.hypotheses > 0 and r.iterations >= 0

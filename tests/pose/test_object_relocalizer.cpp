@@ -644,6 +644,36 @@ TEST(CameraEnvelope, FromKeyframesAndAdmits) {
   EXPECT_GT(estimated->up.z(), 0.9);
 }
 
+// An upright envelope bounds the tilt only: a level or a downward-looking camera at any height
+// passes, one rolled upside down or turned more than max_tilt_deg away from up does not.
+TEST(CameraEnvelope, UprightBoundsTheTiltAtAnyHeight) {
+  const auto e = CameraEnvelope::upright(Eigen::Vector3d(0.0, 0.0, 2.0));  // normalised
+  ASSERT_TRUE(e);
+  EXPECT_TRUE(e->isValid());
+  EXPECT_NEAR(e->up.z(), 1.0, 1e-12);
+  const Eigen::Vector3d target(0.0, 0.0, 0.8);
+  const Pose level = Pose::lookAt({2.0, 0.0, 0.8}, target);
+  EXPECT_NEAR(CameraEnvelope::tiltDegOf(level, e->up), 0.0, 1e-9);
+  EXPECT_TRUE(e->admits(level));
+  EXPECT_TRUE(e->admits(Pose::lookAt({2.0, 0.0, 40.0}, target)));   // high above, looking down
+  EXPECT_TRUE(e->admits(Pose::lookAt({2.0, 0.0, -30.0}, target)));  // far below, looking up
+  // The level camera rolled half a turn about its optical axis: image-up points down.
+  const Eigen::Matrix3d roll = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Pose upside_down(roll * level.rotation(), roll * level.translation());
+  EXPECT_NEAR(upside_down.center().z(), 0.8, 1e-9);  // the same camera centre
+  EXPECT_NEAR(CameraEnvelope::tiltDegOf(upside_down, e->up), 180.0, 1e-6);
+  EXPECT_FALSE(e->admits(upside_down));
+  // A quarter roll is 90 degrees of tilt: inside at 90, outside at 60.
+  const Eigen::Matrix3d quarter = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Pose sideways(quarter * level.rotation(), quarter * level.translation());
+  EXPECT_TRUE(e->admits(sideways));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 60.0)->admits(sideways));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::Zero()));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d(0.0, NAN, 1.0)));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 0.0));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 181.0));
+}
+
 // Relocalization never returns a pose outside the envelope: with the true pose inside it, the
 // pose is found; with an envelope that excludes it, the true pose is not returned.
 TEST(ObjectRelocalizer, EnvelopeGatesPoses) {

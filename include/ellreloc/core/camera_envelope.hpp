@@ -41,6 +41,17 @@ struct CameraEnvelope {
     return h >= min_height && h <= max_height && t >= min_tilt_deg && t <= max_tilt_deg;
   }
 
+  /// A camera at any height whose image-up stays within `max_tilt_deg` of the world's `up`: for
+  /// a host that knows which way is up in its map but has no mapping poses (90: the camera is
+  /// never upside down). nullopt for a zero or non-finite `up` or a tilt outside (0, 180].
+  static std::optional<CameraEnvelope> upright(const Eigen::Vector3d& up, double max_tilt_deg = 90.0) {
+    if (!up.allFinite() || !(up.norm() > 1e-9) || !(max_tilt_deg > 0.0 && max_tilt_deg <= 180.0)) return std::nullopt;
+    CameraEnvelope e;
+    e.up = up.normalized();
+    e.max_tilt_deg = max_tilt_deg;
+    return e;
+  }
+
   /// The envelope of mapping keyframes (world->camera poses): their range of heights widened by
   /// `height_margin` metres and of tilts by `tilt_margin_deg`. `up`: the world's up when known;
   /// nullopt takes the mean image-up direction of the keyframes (hand-held and robot cameras
