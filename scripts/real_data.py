@@ -86,8 +86,10 @@ def main():
                      os.path.join(fr2, "map.json"), os.path.join(fr2, "keyframes.detections.json"),
                      os.path.join(fr2, "keyframes.groundtruth.txt"),
                      [("ours + envelope", ["--envelope", os.path.join(fr2, "keyframes.groundtruth.txt")]),
-                      ("ours, upright camera (--map-up 0,-1,0 --max-tilt 90)", ["--map-up", "0,-1,0", "--max-tilt", "90"]),
-                      ("ours, upright camera, every pose", ["--map-up", "0,-1,0", "--max-tilt", "90", "--accept-all"])]))
+                      ("ours, upright camera (--map-up 0,-1,0 --max-tilt 90)",
+                       ["--map-up", "0,-1,0", "--max-tilt", "90"]),
+                      ("ours, upright camera, every pose",
+                       ["--map-up", "0,-1,0", "--max-tilt", "90", "--accept-all"])]))
         fr3 = os.path.join(data, "tum_fr3_office_first_half")
         camera, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
         frames = json.load(open(os.path.join(fr3, "detections.json")))
@@ -100,7 +102,8 @@ def main():
         rows.append(("office_s11 (independent renderer)", "its noisy map", os.path.join(s11, "camera.yaml"),
                      os.path.join(s11, "map_noisy.json"), os.path.join(s11, "query.detections.json"),
                      os.path.join(s11, "query.groundtruth.txt"),
-                     [("ours, upright camera (--map-up 0,0,1 --max-tilt 90)", ["--map-up", "0,0,1", "--max-tilt", "90"])]))
+                     [("ours, upright camera (--map-up 0,0,1 --max-tilt 90)",
+                       ["--map-up", "0,0,1", "--max-tilt", "90"])]))
 
         print("| data | map | method | valid | wrong poses | median pos | median rot | median time | lost frames: "
               "no pose / search / scoring failure |")

@@ -34,6 +34,7 @@ if [ "$what" = tsan ] || [ "$what" = all ]; then
     -DCMAKE_CXX_FLAGS="-O1 -fsanitize=thread" >/dev/null
   cmake --build build-tsan -j "$jobs" --target concurrency_tests
   echo "sanitize: tsan build done after $((SECONDS - start)) s"
-  # One relocalizer shared by 8 threads, and a mapper read while it maps: same answers as serial.
+  # One relocalizer shared by 8 threads, one frame split over threads, and a mapper read while it
+  # maps: the serial answers.
   TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/concurrency_tests --gtest_filter='*ThreadSafe*:*ReadsWhileMapping*'
 fi
