@@ -3,12 +3,14 @@
 //   fr2   every fr2_desk keyframe (198) against the real GOReloc map
 //   fr3   every 10th frame of the odd frames of the fr3/long_office first half (129) against a map
 //         built from its even frames by the boxes mapper (motion-capture poses)
-// Ours also with each frame's hypotheses split over 2 threads (search.threads).
+// Ours also with each frame's hypotheses split over 2 threads (search.threads), and on fr2 with an
+// upright camera (CameraEnvelope::upright: the map's up is -y, its first keyframe's image-up).
 // Run: ./build/benchmarks/bench_real_frames --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,10 +79,13 @@ double percentile(std::vector<double> v, double p) {
 
 /// One frame per iteration, every frame once per repetition; the counters give the median and
 /// the 90th percentile of the frames' times. state.range(0): the OA-SLAM preset; range(1): the
-/// threads that split each frame's hypotheses (search.threads).
-void relocalizeEveryFrame(benchmark::State& state, const RealSet& set) {
+/// threads that split each frame's hypotheses (search.threads). `up`: the map's up, for a camera
+/// that is never upside down.
+void relocalizeEveryFrame(benchmark::State& state, const RealSet& set,
+                          const std::optional<Eigen::Vector3d>& up = std::nullopt) {
   RelocalizerOptions options = state.range(0) ? RelocalizerOptions::oaSlam() : RelocalizerOptions();
   options.search.threads = static_cast<int>(state.range(1));
+  if (up) options.envelope = CameraEnvelope::upright(*up);
   const ObjectRelocalizer reloc(set.map, set.K, options);
   std::vector<double> times;
   size_t i = 0;
@@ -94,12 +99,16 @@ void relocalizeEveryFrame(benchmark::State& state, const RealSet& set) {
   state.counters["p90_ms"] = percentile(times, 0.9);
 }
 
-void BM_Fr2Keyframes(benchmark::State& state) { relocalizeEveryFrame(state, realSet(0)); }
+void BM_Fr2Keyframes(benchmark::State& state) {
+  relocalizeEveryFrame(state, realSet(0),
+                       state.range(2) ? std::optional<Eigen::Vector3d>(-Eigen::Vector3d::UnitY()) : std::nullopt);
+}
 BENCHMARK(BM_Fr2Keyframes)
-    ->ArgNames({"oaslam", "threads"})
-    ->Args({0, 1})
-    ->Args({0, 2})
-    ->Args({1, 1})
+    ->ArgNames({"oaslam", "threads", "upright"})
+    ->Args({0, 1, 0})
+    ->Args({0, 2, 0})
+    ->Args({1, 1, 0})
+    ->Args({0, 1, 1})
     ->Iterations(198)
     ->Unit(benchmark::kMillisecond);
 
