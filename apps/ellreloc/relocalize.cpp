@@ -79,7 +79,8 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
   auto* map_up =
       r->add_option(
            "--map-up", a.map_up,
-           "the up direction in the map frame, e.g. 0,0,1: with --camera-up a gravity prior; the up of --envelope")
+           "the up direction in the map frame, e.g. 0,0,1: with --camera-up a gravity prior; the up of --envelope "
+           "and of --max-tilt")
           ->expected(3)
           ->delimiter(',');
   camera_up->needs(map_up);
@@ -197,6 +198,8 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
     if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
   }
   if (std::isnan(a.max_tilt_deg)) throw Error("--max-tilt: expected a number of degrees, not NaN");
+  if (a.map_up.size() == 3 && a.camera_up.empty() && a.envelope.empty() && a.max_tilt_deg < 0.0)
+    throw Error("--map-up alone does nothing: add --camera-up (gravity prior), --envelope or --max-tilt");
   if (a.max_tilt_deg >= 0.0) {
     options.envelope = CameraEnvelope::upright(Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]), a.max_tilt_deg);
     if (!options.envelope) throw Error("--max-tilt/--map-up: expected a finite, non-zero up and a tilt in (0, 180]");
