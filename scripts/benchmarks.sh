@@ -49,6 +49,7 @@ fi
 table real_data python3 scripts/real_data.py "$build"
 table fr3_splits python3 scripts/fr3_splits.py "$build"
 table null_frames python3 scripts/null_frames.py "$build"
+table acceptance_margin python3 scripts/acceptance_margin.py "$build"
 table observe_accuracy "$bin/observe_accuracy"
 table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
 # Observations, voxel maps and relocalization on the independent renderer's scene and on two

@@ -63,40 +63,52 @@ def image_size(camera):
     return size["Camera.width"], size["Camera.height"]
 
 
+def null_sets(work):
+    """The null sets as (label, camera, map path, frames), and the real query sets of the same maps
+    as (label, camera, map path, frames, ground truth); the fr3 maps are built in `work`."""
+    fr2, fr3 = os.path.join(data, "tum_fr2_desk"), os.path.join(data, "tum_fr3_office_first_half")
+    s11 = os.path.join(data, "independent_synth", "office_s11")
+    fr2_cam, fr3_cam, s11_cam = (os.path.join(d, "camera.yaml") for d in (fr2, fr3, s11))
+    fr2_frames = json.load(open(os.path.join(fr2, "keyframes.detections.json")))
+    s11_frames = json.load(open(os.path.join(s11, "query.detections.json")))
+    splits = table_splits(json.load(open(os.path.join(fr3, "detections.json"))))
+    fr3_odd, fr3_rest = splits["fr3 even/odd"][1], splits["fr3 60/40"][1]
+    maps = {"fr2": os.path.join(fr2, "map.json"), "s11": os.path.join(s11, "map_noisy.json")}
+    for name, split in (("fr3_even", "fr3 even/odd"), ("fr3_60", "fr3 60/40")):
+        maps[name] = box_map(fr3_cam, os.path.join(fr3, "groundtruth.txt"), *splits[split], work, name)[0]
+
+    def moved(frames, camera, seed):
+        return moved_boxes(frames, *image_size(camera), seed)
+
+    null = [
+        ("fr2_desk keyframes, boxes moved (two draws), vs the fr2 map", fr2_cam, maps["fr2"],
+         moved(fr2_frames, fr2_cam, 1) + moved(fr2_frames, fr2_cam, 2)),
+        ("fr3 odd frames, boxes moved, vs its even-frame map", fr3_cam, maps["fr3_even"], moved(fr3_odd, fr3_cam, 3)),
+        ("fr3 60/40 query frames, boxes moved, vs its 60% map", fr3_cam, maps["fr3_60"], moved(fr3_rest, fr3_cam, 4)),
+        ("office_s11 frames, boxes moved, vs the office_s11 map", s11_cam, maps["s11"], moved(s11_frames, s11_cam, 5)),
+        ("fr3 odd frames vs the fr2 map", fr3_cam, maps["fr2"], fr3_odd),
+        ("fr2 keyframes vs the fr3 even-frame map", fr2_cam, maps["fr3_even"], fr2_frames),
+        ("fr2 keyframes vs the fr3 60% map", fr2_cam, maps["fr3_60"], fr2_frames),
+        ("fr2 keyframes vs the office_s11 map", fr2_cam, maps["s11"], fr2_frames),
+        ("office_s11 frames vs the fr2 map", s11_cam, maps["fr2"], s11_frames),
+        ("office_s11 frames vs the fr3 60% map", s11_cam, maps["fr3_60"], s11_frames),
+    ]
+    real = [
+        ("fr2_desk keyframes", fr2_cam, maps["fr2"], fr2_frames, os.path.join(fr2, "keyframes.groundtruth.txt")),
+        ("fr3 odd frames (even-frame map)", fr3_cam, maps["fr3_even"], fr3_odd, os.path.join(fr3, "groundtruth.txt")),
+        ("fr3 60/40", fr3_cam, maps["fr3_60"], fr3_rest, os.path.join(fr3, "groundtruth.txt")),
+        ("office_s11 (noisy map)", s11_cam, maps["s11"], s11_frames, os.path.join(s11, "query.groundtruth.txt")),
+    ]
+    return null, real
+
+
 def main():
     with tempfile.TemporaryDirectory() as work:
-        fr2, fr3 = os.path.join(data, "tum_fr2_desk"), os.path.join(data, "tum_fr3_office_first_half")
-        s11 = os.path.join(data, "independent_synth", "office_s11")
-        fr2_cam, fr3_cam, s11_cam = (os.path.join(d, "camera.yaml") for d in (fr2, fr3, s11))
-        fr2_frames = json.load(open(os.path.join(fr2, "keyframes.detections.json")))
-        s11_frames = json.load(open(os.path.join(s11, "query.detections.json")))
-        splits = table_splits(json.load(open(os.path.join(fr3, "detections.json"))))
-        fr3_odd, fr3_rest = splits["fr3 even/odd"][1], splits["fr3 60/40"][1]
-        maps = {"fr2": os.path.join(fr2, "map.json"), "s11": os.path.join(s11, "map_noisy.json")}
-        for name, split in (("fr3_even", "fr3 even/odd"), ("fr3_60", "fr3 60/40")):
-            maps[name] = box_map(fr3_cam, os.path.join(fr3, "groundtruth.txt"), *splits[split], work, name)[0]
-
-        def moved(frames, camera, seed):
-            return moved_boxes(frames, *image_size(camera), seed)
-
-        sets = [
-            ("fr2_desk keyframes, boxes moved (two draws), vs the fr2 map", fr2_cam, "fr2",
-             moved(fr2_frames, fr2_cam, 1) + moved(fr2_frames, fr2_cam, 2)),
-            ("fr3 odd frames, boxes moved, vs its even-frame map", fr3_cam, "fr3_even", moved(fr3_odd, fr3_cam, 3)),
-            ("fr3 60/40 query frames, boxes moved, vs its 60% map", fr3_cam, "fr3_60", moved(fr3_rest, fr3_cam, 4)),
-            ("office_s11 frames, boxes moved, vs the office_s11 map", s11_cam, "s11", moved(s11_frames, s11_cam, 5)),
-            ("fr3 odd frames vs the fr2 map", fr3_cam, "fr2", fr3_odd),
-            ("fr2 keyframes vs the fr3 even-frame map", fr2_cam, "fr3_even", fr2_frames),
-            ("fr2 keyframes vs the fr3 60% map", fr2_cam, "fr3_60", fr2_frames),
-            ("fr2 keyframes vs the office_s11 map", fr2_cam, "s11", fr2_frames),
-            ("office_s11 frames vs the fr2 map", s11_cam, "fr2", s11_frames),
-            ("office_s11 frames vs the fr3 60% map", s11_cam, "fr3_60", s11_frames),
-        ]
         print("| null frames (each against the map named) | frames | a pose found | reported |")
         print("| --- | --- | --- | --- |")
         total = [0, 0, 0]
-        for label, camera, map_name, frames in sets:
-            counts = count_poses(camera, maps[map_name], frames, work)
+        for label, camera, map_path, frames in null_sets(work)[0]:
+            counts = count_poses(camera, map_path, frames, work)
             total = [t + c for t, c in zip(total, counts)]
             print("| %s | %d | %d | %d |" % (label, *counts))
         n, found, reported = total

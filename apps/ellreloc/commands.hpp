@@ -74,6 +74,7 @@ struct RelocalizeArgs {
   int threads = 1;
   double max_time_ms = 0.0;  ///< wall-clock budget of each frame's search; 0: none
   double min_evidence = AcceptanceOptions().min_evidence;
+  double min_margin = AcceptanceOptions().min_margin;
   bool accept_all = false;
   /// A gravity prior for every frame when both are given; map_up is also the up of --envelope and
   /// --max-tilt.

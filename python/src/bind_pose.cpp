@@ -219,7 +219,8 @@ void bindOptionGroups(py::module_& m) {
       .def(py::init<>())
       .def_readwrite("enabled", &AcceptanceOptions::enabled)
       .def_readwrite("min_evidence", &AcceptanceOptions::min_evidence)
-      .def_readwrite("unexplained_penalty", &AcceptanceOptions::unexplained_penalty);
+      .def_readwrite("unexplained_penalty", &AcceptanceOptions::unexplained_penalty)
+      .def_readwrite("min_margin", &AcceptanceOptions::min_margin);
 }
 
 void bindPriors(py::module_& m) {
@@ -334,6 +335,10 @@ void bindResult(py::module_& m) {
                     "The evidence: sum of the matches' overlaps minus a penalty per unexplained observation "
                     "(higher is better; the acceptance test compares it with acceptance.min_evidence).")
       .def_readonly("cost", &RelocalizationResult::cost, "Truncated overlap cost (lower is better).")
+      .def_readonly("margin", &RelocalizationResult::margin,
+                    "How much higher the cost of the best rival pose (30 cm or 30 degrees away) is: near 0 when the "
+                    "frame fits two poses alike, inf when no refined hypothesis disagreed "
+                    "(acceptance.min_margin).")
       .def_readonly("mean_overlap", &RelocalizationResult::mean_overlap)
       .def_readonly("skipped", &RelocalizationResult::skipped, "(observation index, reason) of observations not used")
       .def_readonly("hypotheses", &RelocalizationResult::hypotheses)

@@ -42,6 +42,23 @@ def test_relocalize_frames_on_threads_equals_one_by_one(fr2):
             assert [(m.observation, m.object) for m in a.matches] == [(m.observation, m.object) for m in b.matches]
 
 
+def test_a_margin_withholds_ambiguous_poses(fr2):
+    camera, map_, frames = fr2
+    subset = frames[::3]
+    plain = E.ObjectRelocalizer(map_, camera).relocalize_frames(subset, threads=2)
+    options = E.RelocalizerOptions()
+    options.acceptance.min_margin = 0.3
+    strict = E.ObjectRelocalizer(map_, camera, options).relocalize_frames(subset, threads=2)
+    withheld = 0
+    for a, b in zip(plain, strict):
+        if a.success and a.margin < 0.3:  # the same search, then withheld for the margin alone
+            assert b.status == E.RelocalizationStatus.low_evidence and "margin" in b.reason
+            withheld += 1
+        else:
+            assert b.status == a.status
+    assert withheld > 0
+
+
 def test_simulated_frames_relocalize_near_the_truth(office):
     scene, camera, map_ = office
     relocalizer = E.ObjectRelocalizer(map_, camera)
@@ -51,7 +68,7 @@ def test_simulated_frames_relocalize_near_the_truth(office):
         r = relocalizer.relocalize(observations)
         errors.append(E.pose_error(r.pose, truth) if r.pose is not None else None)
         if r.success:
-            assert r.T_wc.shape == (4, 4) and r.score > 2.3 and 0 < r.mean_overlap <= 1
+            assert r.T_wc.shape == (4, 4) and r.score > 2.3 and 0 < r.mean_overlap <= 1 and r.margin >= 0
             for m in r.matches:  # matches pair observations with the objects that made them
                 assert m.object == objects[m.observation]
     summary = E.summarize(errors)

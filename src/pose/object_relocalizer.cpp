@@ -219,6 +219,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   result.pose = chosen.pose;
   result.cost = chosen.cost;
   result.refined = chosen.refined;
+  result.margin = chosen.margin;
   reportMatches(chosen.matches, usable, options_.acceptance, &result);
   const int min_inliers = usable == 1 ? 1 : options_.scoring.min_inliers;  // one observation needs gravity (above)
   if (static_cast<int>(chosen.matches.size()) < min_inliers)
@@ -229,6 +230,13 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
     char reason[160];
     std::snprintf(reason, sizeof reason, "evidence %.2f below %.2f: %zu of %d usable observations explained",
                   result.evidence, options_.acceptance.min_evidence, chosen.matches.size(), usable);
+    return finish(RelocalizationStatus::LowEvidence, reason);
+  }
+  if (options_.acceptance.enabled && result.margin < options_.acceptance.min_margin) {
+    char reason[160];
+    std::snprintf(reason, sizeof reason,
+                  "margin %.2f below %.2f: another pose explains the observations almost as well", result.margin,
+                  options_.acceptance.min_margin);
     return finish(RelocalizationStatus::LowEvidence, reason);
   }
   return finish(RelocalizationStatus::Success, "");

@@ -10,7 +10,9 @@
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/sim/map_observations.hpp"
 #include "fixtures/data_dir.hpp"
+#include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
 
@@ -96,5 +98,56 @@ TEST(Acceptance, NoPoseFromRandomBoxesOrFromAnotherScene) {
     EXPECT_TRUE(r.pose.isValid());
     EXPECT_FALSE(r.inliers.empty());
     break;
+  }
+}
+
+// The margin: a map holding the same layout twice, 20 m apart, fits every frame at two poses
+// alike, so the chosen pose has a rival of the same cost; the layout alone has none close.
+TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
+  std::mt19937 rng(7);
+  const Intrinsics K = test::testIntrinsics();
+  const Eigen::Vector3d shift(20.0, 0.0, 0.0);
+  int tried = 0;
+  while (tried < 5) {
+    ObjectMap map;
+    for (int i = 0; i < 8; ++i)
+      map.objects.push_back({i, i % 4, "",
+                             Ellipsoid({test::uniform(rng, -1.2, 1.2), test::uniform(rng, -1.2, 1.2),
+                                        test::uniform(rng, -0.3, 0.3)},
+                                       {test::uniform(rng, 0.05, 0.25), test::uniform(rng, 0.05, 0.25),
+                                        test::uniform(rng, 0.05, 0.25)},
+                                       test::randomRotation(rng))});
+    const Pose truth = test::randomLookAtPose(rng);
+    const std::vector<Observation> observations = sim::observeMap(map, K, truth);
+    if (observations.size() < 5) continue;
+    ++tried;
+
+    const RelocalizationResult alone = ObjectRelocalizer(map, K).relocalize(observations);
+    ASSERT_EQ(alone.status, RelocalizationStatus::Success) << alone.reason;
+    EXPECT_LT(test::positionError(alone.pose, truth), 0.01);
+    EXPECT_GT(alone.margin, 1.0);  // a rival pose explains at most a few observations, poorly
+
+    ObjectMap twins = map;
+    for (const MapObject& m : map.objects) {
+      MapObject copy = m;
+      copy.id += 100;
+      copy.ellipsoid = Ellipsoid(m.ellipsoid.center() + shift, m.ellipsoid.axes(), m.ellipsoid.rotation());
+      twins.objects.push_back(copy);
+    }
+    const Pose shifted(truth.rotation(), truth.translation() - truth.rotation() * shift);  // the same view of the copy
+    const ObjectRelocalizer twin_reloc(twins, K);
+    const RelocalizationResult r = twin_reloc.relocalize(observations);
+    ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
+    EXPECT_LT(std::min(test::positionError(r.pose, truth), test::positionError(r.pose, shifted)), 0.01);
+    EXPECT_LT(r.margin, 0.01);
+
+    // Asked for a margin, the acceptance test withholds the pose and says why.
+    RelocalizerOptions strict;
+    strict.acceptance.min_margin = 0.1;
+    const RelocalizationResult withheld = ObjectRelocalizer(twins, K, strict).relocalize(observations);
+    EXPECT_EQ(withheld.status, RelocalizationStatus::LowEvidence);
+    EXPECT_NE(withheld.reason.find("margin"), std::string::npos) << withheld.reason;
+    EXPECT_TRUE(withheld.pose.isValid());
+    EXPECT_EQ(ObjectRelocalizer(map, K, strict).relocalize(observations).status, RelocalizationStatus::Success);
   }
 }

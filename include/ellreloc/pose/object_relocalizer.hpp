@@ -19,6 +19,7 @@
 /// A gravity prior drops every hypothesis whose tilt disagrees with it and lets a single
 /// observation give poses.
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,8 +40,9 @@ enum class RelocalizationStatus {
   NoConsistentHypothesis,  ///< no pose explains at least scoring.min_inliers observations
   InvalidInput,            ///< invalid intrinsics, gravity prior or options
   /// A pose was found but the observations support it too weakly (RelocalizationResult::evidence
-  /// below acceptance.min_evidence): frames of random boxes get such poses. `pose` and `inliers`
-  /// hold it, for a host that can check it otherwise (e.g. with points).
+  /// below acceptance.min_evidence, or its margin below acceptance.min_margin): frames of random
+  /// boxes get such poses. `pose` and `inliers` hold it, for a host that can check it otherwise
+  /// (e.g. with points).
   LowEvidence,
 };
 
@@ -64,6 +66,11 @@ struct RelocalizationResult {
   /// Sum of the inliers' overlaps minus half a point per usable observation left unexplained
   /// (AcceptanceOptions).
   double evidence = 0.0;
+  /// How much higher the cost of the best rival is: of the hypotheses refined, the best one
+  /// whose pose is another answer (at least kValidPositionCm or kValidRotationDeg away). Near 0
+  /// when look-alike objects or a symmetric layout fit two poses alike; infinity when every
+  /// refined hypothesis agreed with the pose.
+  double margin = std::numeric_limits<double>::infinity();
   std::vector<std::pair<int, std::string>> skipped;  ///< observations not used, with the reason
   long hypotheses = 0;
   int iterations = 0;

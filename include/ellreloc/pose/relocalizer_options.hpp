@@ -134,6 +134,10 @@ struct AcceptanceOptions {
   bool enabled = true;
   double min_evidence = 2.3;
   double unexplained_penalty = 0.5;
+  /// Poses whose margin over their best rival (RelocalizationResult::margin) is below this get
+  /// LowEvidence too. 0 keeps every margin; 0.1 to 0.3 trade a few valid poses for many fewer
+  /// wrong ones on real data, where wrong poses are ambiguous ones (docs/reliability.md).
+  double min_margin = 0.0;
 };
 
 struct RelocalizerOptions {
@@ -216,6 +220,8 @@ struct RelocalizerOptions {
     if (!std::isfinite(acceptance.min_evidence) ||
         !(std::isfinite(acceptance.unexplained_penalty) && acceptance.unexplained_penalty >= 0))
       return "acceptance.min_evidence is not finite or acceptance.unexplained_penalty is negative";
+    if (!(std::isfinite(acceptance.min_margin) && acceptance.min_margin >= 0))
+      return "acceptance.min_margin is negative or not finite";
     if (envelope && !envelope->isValid())
       return "envelope has a non-unit or non-finite up, or an empty or non-finite range";
     return "";

@@ -3,6 +3,8 @@
 #include <atomic>
 #include <thread>
 
+#include "ellreloc/core/evaluation.hpp"
+
 namespace ellreloc::pipeline {
 
 namespace {
@@ -81,6 +83,12 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
       best.refined = candidate.refined;
     }
   best.cost = scorer.cost(best.pose, kReportIoUVertices, &best.matches);
+  // A rival that refines to another answer almost as well means look-alike objects or a
+  // symmetric layout: the frame cannot tell the two apart.
+  for (const ChosenPose& candidate : refined)
+    if ((candidate.pose.center() - best.pose.center()).norm() * 100.0 >= kValidPositionCm ||
+        rotationErrorDeg(candidate.pose.rotation(), best.pose.rotation()) >= kValidRotationDeg)
+      best.margin = std::min(best.margin, candidate.cost - best.cost);
   return best;
 }
 
@@ -93,6 +101,7 @@ ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& po
   std::vector<ObjectCorrespondence> with_points;
   const double cost = scorer.cost(r.pose, kReportIoUVertices, &with_points);
   if (with_points.size() >= chosen.matches.size() && c.gate.admits(r.pose)) {
+    chosen.margin += chosen.cost - cost;  // the rivals keep their costs
     chosen.pose = r.pose;
     chosen.cost = cost;
     chosen.matches = std::move(with_points);

@@ -2,6 +2,7 @@
 // The refinement stage: the best distinct hypotheses refined with the Wasserstein refiner on
 // all their matches, and optionally with the frame's keypoints.
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -17,6 +18,9 @@ struct ChosenPose {
   double cost = 0.0;
   std::vector<ObjectCorrespondence> matches;
   bool refined = false;
+  /// The cost of the best other refined start whose pose is a different answer (kValidPositionCm
+  /// or kValidRotationDeg away) less this pose's; infinity when no start was.
+  double margin = std::numeric_limits<double>::infinity();
 };
 
 /// What refinement needs besides the pool and the scorer.
@@ -35,7 +39,8 @@ ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementC
 
 /// Starts from `search_best` (the search's best pose) and refines the pooled hypotheses within
 /// refinement.cost_margin of the pool's best, at most `max_refined`, best first; returns the
-/// lowest-cost result. The refinements run on one thread per scorer (the same result).
+/// lowest-cost result, with its margin over the best refined start that lands elsewhere. The
+/// refinements run on one thread per scorer (the same result).
 ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
                             const std::vector<PoseScorer*>& scorers, const RefinementContext& context,
                             size_t max_refined);

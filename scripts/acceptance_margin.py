@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""The "margin" table of docs/reliability.md: what asking for a margin over the best rival pose
+(`ellreloc relocalize --min-margin M`, acceptance.min_margin) does to the poses reported for the
+null frames of scripts/null_frames.py and for the real query frames of the same maps.
+
+Each set is relocalized once with the default acceptance test and `--report`; a pose passes a
+margin M when it was reported and its `margin` (null: no rival) is at least M, which is what
+`--min-margin M` reports (the margin is checked after the evidence, on the same search). The real
+sets are diagnosed against their ground truth (`--reference`): valid poses (< 30 cm, < 30 deg)
+and wrong ones.
+
+Usage: scripts/acceptance_margin.py [BUILD_DIR] [DATA_DIR]   (prints a Markdown table)
+"""
+import json
+import os
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from null_frames import null_sets  # noqa: E402
+from real_data import run  # noqa: E402  (same arguments as real_data.py)
+
+MARGINS = (0.0, 0.1, 0.2, 0.3, 0.5)
+
+
+def reported(camera, map_path, frames, work, groundtruth=None):
+    """(frame count, [(margin, valid)] of the reported poses); valid is None without ground truth."""
+    detections, report = os.path.join(work, "margin.detections.json"), os.path.join(work, "margin.report.json")
+    json.dump(frames, open(detections, "w"))
+    args = ["relocalize", "--camera", camera, "--map", map_path, "--detections", detections, "--threads", "2",
+            "--out", os.path.join(work, "margin.poses.txt"), "--report", report]
+    run(*(args + (["--reference", groundtruth] if groundtruth else [])))
+    poses = []
+    for f in json.load(open(report)):
+        if f["status"] != "success":
+            continue
+        margin = float("inf") if f["margin"] is None else f["margin"]
+        valid = f.get("reference", {}).get("diagnosis") == "valid" if groundtruth else None
+        poses.append((margin, valid))
+    return len(frames), poses
+
+
+def main():
+    with tempfile.TemporaryDirectory() as work:
+        null, real = null_sets(work)
+        null_frames, null_poses = 0, []
+        for _, camera, map_path, frames in null:
+            n, poses = reported(camera, map_path, frames, work)
+            null_frames += n
+            null_poses += poses
+        real_runs = [(label, reported(camera, map_path, frames, work, truth)) for label, camera, map_path, frames, truth
+                     in real]
+        print("| min margin | null frames reported (of %s) | %s | all real frames: valid / wrong |" %
+              ("{:,}".format(null_frames), " | ".join("%s (%d): valid / wrong" % (label, n)
+                                                      for label, (n, _) in real_runs)))
+        print("|---" * (3 + len(real_runs)) + "|")
+        for m in MARGINS:
+            passed = sum(1 for margin, _ in null_poses if margin >= m)
+            cells, total_valid, total_wrong = [], 0, 0
+            for _, (n, poses) in real_runs:
+                valid = sum(1 for margin, ok in poses if margin >= m and ok)
+                wrong = sum(1 for margin, ok in poses if margin >= m and not ok)
+                total_valid, total_wrong = total_valid + valid, total_wrong + wrong
+                cells.append("%d / %d" % (valid, wrong))
+            print("| %s | %d (%.2f%%) | %s | %d / %d |" % ("%.1f%s" % (m, " (default)" if m == 0 else ""), passed,
+                                                           100.0 * passed / null_frames, " | ".join(cells),
+                                                           total_valid, total_wrong))
+
+
+if __name__ == "__main__":
+    main()
