@@ -1,6 +1,7 @@
 // `ellreloc relocalize`.
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -255,13 +256,21 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                        {"object_id", map.objects[static_cast<size_t>(c.object)].id},
                        {"overlap", c.overlap}});
   j["matches"] = matches;
-  if (reference)
+  j["rival"] = nullptr;
+  if (r.rival) {  // as a TUM line has it: camera centre and camera->world rotation
+    const Eigen::Vector3d c = r.rival->center();
+    const Eigen::Quaterniond q(r.rival->rotation().transpose());
+    j["rival"] = {{"position", {c.x(), c.y(), c.z()}}, {"quaternion", {q.x(), q.y(), q.z(), q.w()}}};
+  }
+  if (reference) {
     j["reference"] = {{"score", ref.given.cost},
                       {"inliers", ref.given.inliers.size()},
                       {"refined_score", ref.refined.cost},
                       {"refined_inliers", ref.refined.inliers.size()},
                       {"refined_moved_cm", poseError(ref.refined.pose, *reference).position_cm},
                       {"diagnosis", diagnosis}};
+    if (r.rival) j["reference"]["rival_valid"] = poseError(*r.rival, *reference).valid();
+  }
   return j;
 }
 

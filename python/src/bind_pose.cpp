@@ -339,6 +339,10 @@ void bindResult(py::module_& m) {
                     "How much higher the cost of the best rival pose (30 cm or 30 degrees away) is: near 0 when the "
                     "frame fits two poses alike, inf when no refined hypothesis disagreed "
                     "(acceptance.min_margin).")
+      .def_property_readonly(
+          "rival", [](const RelocalizationResult& r) { return hasPose(r) ? r.rival : std::nullopt; },
+          "The best refined pose that is another answer (30 cm or 30 degrees away; world->camera), whose cost is "
+          "`margin` higher, or None: a host that checks poses with its points can try it when `pose` fails.")
       .def_readonly("mean_overlap", &RelocalizationResult::mean_overlap)
       .def_readonly("skipped", &RelocalizationResult::skipped, "(observation index, reason) of observations not used")
       .def_readonly("hypotheses", &RelocalizationResult::hypotheses)

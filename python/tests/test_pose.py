@@ -53,6 +53,9 @@ def test_a_margin_withholds_ambiguous_poses(fr2):
     for a, b in zip(plain, strict):
         if a.success and a.margin < 0.3:  # the same search, then withheld for the margin alone
             assert b.status == E.RelocalizationStatus.low_evidence and "margin" in b.reason
+            assert b.rival is not None  # the other answer, for a host that checks poses with points
+            apart = E.pose_error(b.rival, b.pose)
+            assert apart.position_cm >= 30 or apart.rotation_deg >= 30
             withheld += 1
         else:
             assert b.status == a.status

@@ -102,7 +102,8 @@ TEST(Acceptance, NoPoseFromRandomBoxesOrFromAnotherScene) {
 }
 
 // The margin: a map holding the same layout twice, 20 m apart, fits every frame at two poses
-// alike, so the chosen pose has a rival of the same cost; the layout alone has none close.
+// alike, so the chosen pose has a rival of the same cost, the other copy's view; the layout
+// alone has none close.
 TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
   std::mt19937 rng(7);
   const Intrinsics K = test::testIntrinsics();
@@ -140,6 +141,11 @@ TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
     ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
     EXPECT_LT(std::min(test::positionError(r.pose, truth), test::positionError(r.pose, shifted)), 0.01);
     EXPECT_LT(r.margin, 0.01);
+    // The rival is the view of the other copy: the pose a host would try next.
+    ASSERT_TRUE(r.rival);
+    const Pose& other = test::positionError(r.pose, truth) < 1.0 ? shifted : truth;
+    EXPECT_LT(test::positionError(*r.rival, other), 0.01);
+    EXPECT_LT(test::rotationError(*r.rival, other), 0.5);
 
     // Asked for a margin, the acceptance test withholds the pose and says why.
     RelocalizerOptions strict;

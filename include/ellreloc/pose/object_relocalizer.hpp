@@ -71,6 +71,9 @@ struct RelocalizationResult {
   /// when look-alike objects or a symmetric layout fit two poses alike; infinity when every
   /// refined hypothesis agreed with the pose.
   double margin = std::numeric_limits<double>::infinity();
+  /// That rival's pose (world->camera), when there was one: a host that checks poses with its
+  /// points can try it when `pose` fails the check.
+  std::optional<Pose> rival;
   std::vector<std::pair<int, std::string>> skipped;  ///< observations not used, with the reason
   long hypotheses = 0;
   int iterations = 0;

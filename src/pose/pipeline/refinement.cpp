@@ -85,10 +85,14 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
   best.cost = scorer.cost(best.pose, kReportIoUVertices, &best.matches);
   // A rival that refines to another answer almost as well means look-alike objects or a
   // symmetric layout: the frame cannot tell the two apart.
-  for (const ChosenPose& candidate : refined)
-    if ((candidate.pose.center() - best.pose.center()).norm() * 100.0 >= kValidPositionCm ||
-        rotationErrorDeg(candidate.pose.rotation(), best.pose.rotation()) >= kValidRotationDeg)
-      best.margin = std::min(best.margin, candidate.cost - best.cost);
+  for (const ChosenPose& candidate : refined) {
+    const bool elsewhere = (candidate.pose.center() - best.pose.center()).norm() * 100.0 >= kValidPositionCm ||
+                           rotationErrorDeg(candidate.pose.rotation(), best.pose.rotation()) >= kValidRotationDeg;
+    if (elsewhere && candidate.cost - best.cost < best.margin) {
+      best.margin = candidate.cost - best.cost;
+      best.rival = candidate.pose;
+    }
+  }
   return best;
 }
 

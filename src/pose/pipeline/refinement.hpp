@@ -18,8 +18,9 @@ struct ChosenPose {
   double cost = 0.0;
   std::vector<ObjectCorrespondence> matches;
   bool refined = false;
-  /// The cost of the best other refined start whose pose is a different answer (kValidPositionCm
-  /// or kValidRotationDeg away) less this pose's; infinity when no start was.
+  /// The best other refined start whose pose is a different answer (kValidPositionCm or
+  /// kValidRotationDeg away), and its cost less this pose's (infinity when no start was).
+  std::optional<Pose> rival;
   double margin = std::numeric_limits<double>::infinity();
 };
 
