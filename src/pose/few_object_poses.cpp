@@ -9,16 +9,25 @@
 
 namespace ellreloc {
 
-std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Matrix3d& R_cw,
-                                           const EllipseMatch& match) {
-  const Ellipse& observed = match.observed;
-  const Ellipsoid& e = match.ellipsoid;
-  if (!K.isValid() || !observed.isValid() || !e.isValid() || !isRotation(R_cw)) return std::nullopt;
+namespace {
+
+/// project() for an ellipsoid prepared once and a rotation that is one by construction (the
+/// sweep's come from axis-angles and quaternions; placeObject checks a caller's): the same
+/// result without building the ellipsoid's matrices and checking the rotation at every step.
+Projection projectAt(const ProjectableEllipsoid& e, const Intrinsics& K, const Pose& pose) {
+  if (!pose.translation().allFinite()) return Projection{};
+  return projectPrepared(e, projectionMatrix(K, pose), pose);
+}
+
+/// placeObject for a prepared, valid ellipsoid and a rotation.
+std::optional<Eigen::Vector3d> placePrepared(const Intrinsics& K, const Eigen::Matrix3d& R_cw, const Ellipse& observed,
+                                             const ProjectableEllipsoid& prepared) {
+  const Ellipsoid& e = prepared.ellipsoid;
   const double observed_size = std::sqrt(observed.axes().prod());
   Eigen::Vector3d bearing = K.bearing(observed.center());
   // First depth from the silhouette seen along the bearing (orthographic): its radius
   // det(S)^(1/4), S the camera-frame shape matrix restricted to the plane across the bearing.
-  const Eigen::Matrix3d M = R_cw * e.shapeMatrix() * R_cw.transpose();
+  const Eigen::Matrix3d M = R_cw * prepared.shape * R_cw.transpose();
   const Eigen::Vector3d u = bearing.unitOrthogonal(), v = bearing.cross(u);
   Eigen::Matrix2d S;
   S << u.dot(M * u), u.dot(M * v), v.dot(M * u), v.dot(M * v);
@@ -29,7 +38,7 @@ std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Mat
   // projected ellipse is not the projection of the centre; a few fixed-point steps fix both.
   for (int iteration = 0; iteration < 4; ++iteration) {
     const Pose pose(R_cw, depth * bearing - R_cw * e.center());
-    const Projection p = project(e, K, pose);
+    const Projection p = projectAt(prepared, K, pose);
     if (!p) {
       depth *= 2.0;  // too close: the ellipsoid reaches behind the principal plane
       continue;
@@ -39,19 +48,29 @@ std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Mat
     bearing = K.bearing(observed.center() - offset);
   }
   const Eigen::Vector3d t = depth * bearing - R_cw * e.center();
-  if (!t.allFinite() || !project(e, K, Pose(R_cw, t))) return std::nullopt;
+  if (!t.allFinite() || !projectAt(prepared, K, Pose(R_cw, t))) return std::nullopt;
   return t;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Matrix3d& R_cw,
+                                           const EllipseMatch& match) {
+  if (!K.isValid() || !match.observed.isValid() || !match.ellipsoid.isValid() || !isRotation(R_cw)) return std::nullopt;
+  return placePrepared(K, R_cw, match.observed, ProjectableEllipsoid(match.ellipsoid));
 }
 
 namespace {
 
 /// The refiner's object cost (its robust loss of the normalised W2^2) plus the gravity term: the
-/// sweep ranks angles by what the refinement will minimise.
+/// sweep ranks angles by what the refinement will minimise. `prepared`: the matches' ellipsoids.
 double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<EllipseMatch>& matches,
-                 const std::optional<GravityPrior>& gravity, const RefinerOptions& opt) {
+                 const std::vector<ProjectableEllipsoid>& prepared, const std::optional<GravityPrior>& gravity,
+                 const RefinerOptions& opt) {
   double total = 0.0;
-  for (const EllipseMatch& m : matches) {
-    const Projection p = project(m.ellipsoid, K, pose);
+  for (size_t i = 0; i < matches.size(); ++i) {
+    const EllipseMatch& m = matches[i];
+    const Projection p = projectAt(prepared[i], K, pose);
     if (!p) return std::numeric_limits<double>::infinity();
     const double s = wasserstein2Squared(m.observed, p.ellipse) / m.observed.axes().prod();
     total += robustLoss(opt.object_loss, opt.object_loss_scale, s);
@@ -64,15 +83,21 @@ double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<Ellips
 }
 
 /// Places every object at rotation R_cw; the translation is the mean of their placements.
-std::optional<Pose> placeAll(const Intrinsics& K, const Eigen::Matrix3d& R_cw,
-                             const std::vector<EllipseMatch>& matches) {
+std::optional<Pose> placeAll(const Intrinsics& K, const Eigen::Matrix3d& R_cw, const std::vector<EllipseMatch>& matches,
+                             const std::vector<ProjectableEllipsoid>& prepared) {
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  for (const EllipseMatch& m : matches) {
-    const auto ti = placeObject(K, R_cw, m);
+  for (size_t i = 0; i < matches.size(); ++i) {
+    const auto ti = placePrepared(K, R_cw, matches[i].observed, prepared[i]);
     if (!ti) return std::nullopt;
     t += *ti / static_cast<double>(matches.size());
   }
   return Pose(R_cw, t);
+}
+
+std::vector<ProjectableEllipsoid> prepare(const std::vector<EllipseMatch>& matches) {
+  std::vector<ProjectableEllipsoid> out;
+  for (const EllipseMatch& m : matches) out.emplace_back(m.ellipsoid);
+  return out;
 }
 
 /// Sweeps poseAt(angle) (a ScoredPose with the sweep cost, or nullopt) over a full turn,
@@ -149,13 +174,14 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
   for (const Eigen::Vector3d& c : camera_axes)
     if (c.allFinite()) aligns.push_back(Eigen::Quaterniond::FromTwoVectors(w, c).toRotationMatrix());
   const std::vector<EllipseMatch> matches{a, b};
+  const std::vector<ProjectableEllipsoid> prepared = prepare(matches);
   return sweepAndRefine(K, matches, gravity, options, [&](double angle) -> std::optional<ScoredPose> {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, w).toRotationMatrix();
     std::optional<ScoredPose> best;
     for (const Eigen::Matrix3d& align : aligns) {
-      const std::optional<Pose> pose = placeAll(K, align * turn, matches);
+      const std::optional<Pose> pose = placeAll(K, align * turn, matches, prepared);
       if (!pose) continue;
-      const double cost = sweepCost(K, *pose, matches, gravity, options.refiner);
+      const double cost = sweepCost(K, *pose, matches, prepared, gravity, options.refiner);
       if (!best || cost < best->cost) best = ScoredPose{*pose, cost};
     }
     return best;
@@ -170,10 +196,12 @@ std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMat
   const Eigen::Matrix3d align =
       Eigen::Quaterniond::FromTwoVectors(up, gravity.up_in_camera.normalized()).toRotationMatrix();
   const std::vector<EllipseMatch> matches{a};
+  const std::vector<ProjectableEllipsoid> prepared = prepare(matches);
   return sweepAndRefine(K, matches, gravity, options, [&](double yaw) -> std::optional<ScoredPose> {
-    const std::optional<Pose> pose = placeAll(K, align * Eigen::AngleAxisd(yaw, up).toRotationMatrix(), matches);
+    const std::optional<Pose> pose =
+        placeAll(K, align * Eigen::AngleAxisd(yaw, up).toRotationMatrix(), matches, prepared);
     if (!pose) return std::nullopt;
-    return ScoredPose{*pose, sweepCost(K, *pose, matches, gravity, options.refiner)};
+    return ScoredPose{*pose, sweepCost(K, *pose, matches, prepared, gravity, options.refiner)};
   });
 }
 
