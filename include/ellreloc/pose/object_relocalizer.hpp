@@ -69,7 +69,8 @@ struct RelocalizationResult {
   /// How much higher the cost of the best rival is: of the hypotheses refined, the best one
   /// whose pose is another answer (at least kValidPositionCm or kValidRotationDeg away). Near 0
   /// when look-alike objects or a symmetric layout fit two poses alike; infinity when every
-  /// refined hypothesis agreed with the pose.
+  /// refined hypothesis agreed with the pose, or only one was refined (the OA-SLAM preset, or a
+  /// spent search.budget.max_time_ms).
   double margin = std::numeric_limits<double>::infinity();
   /// That rival's pose (world->camera), when there was one: a host that checks poses with its
   /// points can try it when `pose` fails the check.
