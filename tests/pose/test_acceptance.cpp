@@ -136,7 +136,11 @@ TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
       twins.objects.push_back(copy);
     }
     const Pose shifted(truth.rotation(), truth.translation() - truth.rotation() * shift);  // the same view of the copy
-    const ObjectRelocalizer twin_reloc(twins, K);
+    // Every triplet, so that both copies' views are found whatever the sampler's stopping rule
+    // (the twin map doubles the candidates: beyond the exhaustive search's default bound).
+    RelocalizerOptions every_triplet;
+    every_triplet.search.sampler = HypothesisSampler::Exhaustive;
+    const ObjectRelocalizer twin_reloc(twins, K, every_triplet);
     const RelocalizationResult r = twin_reloc.relocalize(observations);
     ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
     EXPECT_LT(std::min(test::positionError(r.pose, truth), test::positionError(r.pose, shifted)), 0.01);
@@ -148,7 +152,7 @@ TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
     EXPECT_LT(test::rotationError(*r.rival, other), 0.5);
 
     // Asked for a margin, the acceptance test withholds the pose and says why.
-    RelocalizerOptions strict;
+    RelocalizerOptions strict = every_triplet;
     strict.acceptance.min_margin = 0.1;
     const RelocalizationResult withheld = ObjectRelocalizer(twins, K, strict).relocalize(observations);
     EXPECT_EQ(withheld.status, RelocalizationStatus::LowEvidence);

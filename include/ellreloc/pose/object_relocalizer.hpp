@@ -70,7 +70,9 @@ struct RelocalizationResult {
   /// whose pose is another answer (at least kValidPositionCm or kValidRotationDeg away). Near 0
   /// when look-alike objects or a symmetric layout fit two poses alike; infinity when every
   /// refined hypothesis agreed with the pose, or only one was refined (the OA-SLAM preset, or a
-  /// spent search.budget.max_time_ms).
+  /// spent search.budget.max_time_ms). Rivals are the hypotheses the search found: a sampled
+  /// search (beyond search.max_exhaustive_triplets) may stop before meeting one, and the margin
+  /// is then too high.
   double margin = std::numeric_limits<double>::infinity();
   /// That rival's pose (world->camera), when there was one: a host that checks poses with its
   /// points can try it when `pose` fails the check.
