@@ -257,9 +257,10 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                        {"overlap", c.overlap}});
   j["matches"] = matches;
   j["rival"] = nullptr;
-  if (r.rival) {  // as a TUM line has it: camera centre and camera->world rotation
-    const Eigen::Vector3d c = r.rival->center();
-    const Eigen::Quaterniond q(r.rival->rotation().transpose());
+  if (r.rival) {  // camera->world, as a TUM line has it
+    const Pose camera_to_world = r.rival->inverse();
+    const Eigen::Vector3d& c = camera_to_world.translation();
+    const Eigen::Quaterniond q(camera_to_world.rotation());
     j["rival"] = {{"position", {c.x(), c.y(), c.z()}}, {"quaternion", {q.x(), q.y(), q.z(), q.w()}}};
   }
   if (reference) {

@@ -86,8 +86,7 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
   // A rival that refines to another answer almost as well means look-alike objects or a
   // symmetric layout: the frame cannot tell the two apart.
   for (const ChosenPose& candidate : refined) {
-    const bool elsewhere = (candidate.pose.center() - best.pose.center()).norm() * 100.0 >= kValidPositionCm ||
-                           rotationErrorDeg(candidate.pose.rotation(), best.pose.rotation()) >= kValidRotationDeg;
+    const bool elsewhere = !poseError(candidate.pose, best.pose).valid();  // another answer
     if (elsewhere && candidate.cost - best.cost < best.margin) {
       best.margin = candidate.cost - best.cost;
       best.rival = candidate.pose;
