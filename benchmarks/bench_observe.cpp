@@ -41,15 +41,19 @@ void BM_ObserveOurs(benchmark::State& state) {
   d.mask = encodeMask(m);
   d.bbox = rleMoments(*d.mask)->bounds;
   ObserveOptions opt;
-  opt.policy = state.range(1) ? ObservationPolicy::Paper : ObservationPolicy::Mask;
+  constexpr ObservationPolicy kPolicies[] = {ObservationPolicy::Mask, ObservationPolicy::Paper,
+                                             ObservationPolicy::Solid};
+  opt.policy = kPolicies[state.range(1)];
   for (auto _ : state) benchmark::DoNotOptimize(observeDetection(d, 640, 480, opt));
 }
-// policy 0: `mask` (always fit the mask); 1: `paper` (the default: irregular masks keep the box)
+// policy 0: `mask` (always fit the mask); 1: `paper` (irregular masks keep the box); 2: `solid`
+// (the default: solid irregular masks, as this one, are fitted too)
 BENCHMARK(BM_ObserveOurs)
-    ->ArgNames({"regular", "paper"})
-    ->Args({1, 0})
-    ->Args({0, 0})
+    ->ArgNames({"regular", "policy"})
+    ->Args({1, 2})
+    ->Args({0, 2})
     ->Args({0, 1})
+    ->Args({0, 0})
     ->Unit(benchmark::kMicrosecond);
 
 void BM_ObserveOpenCv(benchmark::State& state) {

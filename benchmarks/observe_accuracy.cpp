@@ -10,8 +10,8 @@
 #include <random>
 
 #include "ellreloc/core/distances.hpp"
-#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/core/projection.hpp"
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/observe/ellipse_fit.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "fixtures/mask_shapes.hpp"
@@ -147,16 +147,20 @@ int main() {
     Detection det;
     det.bbox = moments->bounds;
     det.mask = rle;
-    const ObserveResult paper = observeDetection(det, kK.width, kK.height);
-    if (paper.observation) record("default (paper policy)", paper.observation->ellipse);
+    ObserveOptions paper;
+    paper.policy = ObservationPolicy::Paper;
+    if (const ObserveResult r = observeDetection(det, kK.width, kK.height, paper); r.observation)
+      record("paper policy", r.observation->ellipse);
+    if (const ObserveResult r = observeDetection(det, kK.width, kK.height); r.observation)
+      record("default (solid policy)", r.observation->ellipse);
   }
   std::printf(
-      "| masks | n | box-inscribed | moments | direct (outline) | hull | quadrilateral | default (paper policy) "
-      "|\n|---|---|---|---|---|---|---|---|\n");
+      "| masks | n | box-inscribed | moments | direct (outline) | hull | quadrilateral | paper policy | "
+      "default (solid policy) |\n|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& [group, methods] : errors) {
     std::printf("| %s | %zu |", group.c_str(), methods.at("box-inscribed").size());
-    for (const char* m :
-         {"box-inscribed", "moments", "direct (outline)", "hull", "quadrilateral", "default (paper policy)"}) {
+    for (const char* m : {"box-inscribed", "moments", "direct (outline)", "hull", "quadrilateral", "paper policy",
+                          "default (solid policy)"}) {
       const auto it = methods.find(m);
       if (it == methods.end())
         std::printf(" - |");

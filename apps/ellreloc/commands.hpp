@@ -47,11 +47,11 @@ CLI::App* addSimulateCommand(CLI::App& app, SimulateArgs& a);
 void simulate(const SimulateArgs& a, const Console& console);
 
 struct ObserveArgs {
-  std::string camera, detections, policy = "paper", out;
+  std::string camera, detections, policy = "solid", out;
 };
 CLI::App* addObserveCommand(CLI::App& app, ObserveArgs& a);
 void observe(const ObserveArgs& a, const Console& console);
-/// paper, bbox, mask or given; anything else is an Error naming --policy.
+/// solid, paper, bbox, mask or given; anything else is an Error naming --policy.
 ObservationPolicy parsePolicy(const std::string& name);
 
 struct MapArgs {

@@ -13,16 +13,16 @@ CLI::App* addObserveCommand(CLI::App& app, ObserveArgs& a) {
   CLI::App* o = app.add_subcommand("observe", "fill each detection's `ellipse` and `regular` fields");
   o->add_option("--camera", a.camera, "camera.yaml or .json")->required()->check(CLI::ExistingFile);
   o->add_option("--detections", a.detections, "detections JSON")->required()->check(CLI::ExistingFile);
-  o->add_option("--policy", a.policy, "paper, bbox or mask (docs/observe.md)")->capture_default_str();
+  o->add_option("--policy", a.policy, "solid, paper, bbox, mask or given (docs/observe.md)")->capture_default_str();
   o->add_option("--out", a.out, "output detections JSON")->required();
-  o->footer("Example: ellreloc observe --camera C.yaml --detections D.json --policy paper --out O.json");
+  o->footer("Example: ellreloc observe --camera C.yaml --detections D.json --policy solid --out O.json");
   return o;
 }
 
 ObservationPolicy parsePolicy(const std::string& name) {
   ObservationPolicy policy;
   if (parseObservationPolicy(name, &policy)) return policy;
-  throw Error("--policy: unknown policy '" + name + "' (paper, bbox, mask, given)");
+  throw Error("--policy: unknown policy '" + name + "' (solid, paper, bbox, mask, given)");
 }
 
 void observe(const ObserveArgs& a, const Console& console) {

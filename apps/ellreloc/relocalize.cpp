@@ -34,7 +34,7 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
       ->required()
       ->check(CLI::ExistingFile);
   r->add_option("--method", a.method, "ours or oa-slam (the OA-SLAM baseline)")->capture_default_str();
-  r->add_option("--policy", a.policy, "observation policy (default: paper for ours, bbox for oa-slam)");
+  r->add_option("--policy", a.policy, "observation policy (default: solid for ours, bbox for oa-slam)");
   r->add_option("--out", a.out, "TUM poses of the relocalized frames")->required();
   r->add_option("--report", a.report, "per-frame JSON report: status, inliers, score, time");
   r->add_option("--reference", a.reference,
@@ -338,7 +338,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   std::string policy = a.policy;
   const RelocalizerOptions options = relocalizerOptions(a, &policy);
   ObserveOptions observe_options;
-  observe_options.policy = parsePolicy(policy.empty() ? "paper" : policy);
+  observe_options.policy = parsePolicy(policy.empty() ? "solid" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
   std::optional<GravityPrior> gravity;
   if (a.camera_up.size() == 3 && a.map_up.size() == 3) {

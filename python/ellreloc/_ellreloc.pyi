@@ -15,6 +15,7 @@ class AcceptanceOptions:
     enabled: bool
     min_evidence: float
     unexplained_penalty: float
+    min_margin: float
 
 
 class Association:
@@ -48,6 +49,8 @@ class CameraEnvelope:
     """Where the camera can be: heights along `up` and tilts."""
     @staticmethod
     def from_keyframes(keyframes: list[Pose], up: ArrayLike | None = ..., height_margin: float = ..., tilt_margin_deg: float = ...) -> CameraEnvelope: """The envelope of mapping keyframes, widened by the margins."""
+    @staticmethod
+    def upright(up: ArrayLike | None, max_tilt_deg: float = ...) -> CameraEnvelope: """A camera at any height whose image-up stays within max_tilt_deg of `up` (90: never upside down)."""
     up: numpy.ndarray
     min_height: float
     max_height: float
@@ -353,6 +356,7 @@ class Observation:
 
 class ObservationPolicy:
     """Which ellipse a detection gives."""
+    solid: ObservationPolicy
     paper: ObservationPolicy
     bbox: ObservationPolicy
     mask: ObservationPolicy
@@ -371,6 +375,7 @@ class ObserveOptions:
     irregular_fit: MaskFitMethod
     regular: RegularMaskOptions
     border_px: float
+    solid_min_solidity: float
     def validate(self) -> str: """'' when every threshold is in range, else the first that is not."""
 
 
@@ -520,6 +525,8 @@ class RelocalizationResult:
     matches: list[Match]
     score: float
     cost: float
+    margin: float
+    rival: Optional[Pose]
     mean_overlap: float
     skipped: list[tuple[int, str]]
     hypotheses: int
@@ -692,7 +699,7 @@ def observation_from_box(category: int, box: Box | ArrayLike, width: int, height
 
 def observation_from_mask(mask: MaskLike, category: int = ..., score: float = ..., box: Box | ArrayLike = ..., policy: str | ObservationPolicy | None = ..., options: Optional[ObserveOptions] = ...) -> ObserveResult: """Observes an instance mask (numpy bool/uint8 array, COCO RLE dict or RleMask) whose size is the image's; the box defaults to the mask's. Policy 'mask' by default; 'paper' fits regular masks only."""
 
-def observe(detection: Detection, width: int, height: int, policy: str | ObservationPolicy | None = ..., options: Optional[ObserveOptions] = ...) -> ObserveResult: """Observes one detection of a width x height image; `policy` (a name or ObservationPolicy) overrides options.policy (default 'paper')."""
+def observe(detection: Detection, width: int, height: int, policy: str | ObservationPolicy | None = ..., options: Optional[ObserveOptions] = ...) -> ObserveResult: """Observes one detection of a width x height image; `policy` (a name or ObservationPolicy) overrides options.policy (default 'solid')."""
 
 def observe_frame(frame: DetectionFrame | Sequence[Detection], camera: Intrinsics, policy: str | ObservationPolicy | None = ..., options: Optional[ObserveOptions] = ...) -> list[Observation]: """The observations of a DetectionFrame (or a list of Detection), as `ellreloc relocalize` makes them: detections without one are left out."""
 

@@ -15,7 +15,7 @@ ObservationPolicy policyFrom(const py::handle& h) {
   if (py::isinstance<ObservationPolicy>(h)) return h.cast<ObservationPolicy>();
   ObservationPolicy p;
   if (py::isinstance<py::str>(h) && parseObservationPolicy(h.cast<std::string>(), &p)) return p;
-  badArgument("policy", "expected 'paper', 'bbox', 'mask' or 'given', got " + std::string(py::repr(h)));
+  badArgument("policy", "expected 'solid', 'paper', 'bbox', 'mask' or 'given', got " + std::string(py::repr(h)));
 }
 
 namespace {
@@ -29,6 +29,8 @@ ObserveOptions optionsFrom(const std::optional<ObserveOptions>& options, const p
 
 void bindOptions(py::module_& m) {
   py::enum_<ObservationPolicy>(m, "ObservationPolicy", "Which ellipse a detection gives.")
+      .value("solid", ObservationPolicy::Solid,
+             "regular mask -> mask fit, a solid one (options.solid_min_solidity) -> hull fit, otherwise the box")
       .value("paper", ObservationPolicy::Paper, "regular mask -> mask fit, otherwise the box-inscribed ellipse")
       .value("bbox", ObservationPolicy::Bbox, "always the box-inscribed ellipse (OA-SLAM)")
       .value("mask", ObservationPolicy::Mask, "fit the mask whenever there is one")
@@ -56,6 +58,8 @@ void bindOptions(py::module_& m) {
       .def_readwrite("irregular_fit", &ObserveOptions::irregular_fit)
       .def_readwrite("regular", &ObserveOptions::regular)
       .def_readwrite("border_px", &ObserveOptions::border_px)
+      .def_readwrite("solid_min_solidity", &ObserveOptions::solid_min_solidity,
+                     "policy 'solid': a non-regular mask covering at least this share of its convex hull gets the hull fit")
       .def("validate", &ObserveOptions::validate, "'' when every threshold is in range, else the first that is not.");
 }
 
@@ -101,7 +105,7 @@ void bindFunctions(py::module_& m) {
       py::arg("detection"), py::arg("width"), py::arg("height"), py::arg("policy") = py::none(),
       py::arg("options") = py::none(),
       "Observes one detection of a width x height image; `policy` (a name or ObservationPolicy) overrides "
-      "options.policy (default 'paper').");
+      "options.policy (default 'solid').");
   m.def(
       "observe_frame",
       [](const py::handle& frame, const Intrinsics& K, const py::handle& policy,

@@ -69,7 +69,7 @@ Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optio
   }
   if (const std::string why = options.validate(); !why.empty()) badArgument("options", why);
   ObserveOptions observe;
-  observe.policy = method == "oa-slam" ? ObservationPolicy::Bbox : ObservationPolicy::Paper;
+  observe.policy = method == "oa-slam" ? ObservationPolicy::Bbox : ObservationPolicy::Solid;
   if (!policy.is_none()) observe.policy = policyFrom(policy);
   return Relocalizer{ObjectRelocalizer(std::move(map), K, options), observe, method};
 }

@@ -76,6 +76,12 @@ def test_regular_and_irregular_masks():
     # A disc is not regular: the paper's policy falls back to the box; the moments fit the disc.
     d = E.observation_from_mask(disc(), policy="paper")
     assert d.observation.source == E.EllipseSource.box and d.observation.regular is False
+    # The default policy fits the hull of a solid non-regular mask, and keeps the box below the threshold.
+    solid = E.observe(E.Detection(0, d.observation.box, mask=disc()), 160, 120).observation
+    assert solid.source == E.EllipseSource.mask and solid.regular is False
+    strict = E.ObserveOptions()
+    strict.solid_min_solidity = 1.0
+    assert E.observation_from_mask(disc(), policy="solid", options=strict).observation.source == E.EllipseSource.box
     fit = E.fit_mask_ellipse(disc(r=30.0), E.MaskFitMethod.moments)
     np.testing.assert_allclose(fit.center, [70.0, 60.0], atol=1e-6)
     np.testing.assert_allclose(fit.axes, [30.0, 30.0], rtol=0.02)
@@ -95,7 +101,7 @@ def test_box_observations_and_policies():
     assert E.observation_from_box(56, E.Box(10, 20, 10, 70), 640, 480) is None
     assert E.observe(d, 640, 480, policy="given").status == E.ObserveStatus.no_ellipse
     assert E.observe(E.Detection(0, [5, 5, 5, 9]), 640, 480).status == E.ObserveStatus.invalid_box
-    with pytest.raises(ValueError, match="policy: expected 'paper', 'bbox', 'mask' or 'given'"):
+    with pytest.raises(ValueError, match="policy: expected 'solid', 'paper', 'bbox', 'mask' or 'given'"):
         E.observe(d, 640, 480, policy="boxes")
     options = E.ObserveOptions()
     options.border_px = -1

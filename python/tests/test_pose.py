@@ -175,7 +175,7 @@ def test_options_and_bad_input_are_refused_clearly(fr2):
         E.ObjectRelocalizer(map_, camera, scorin={})
     with pytest.raises(ValueError, match="method: expected 'ours' or 'oa-slam'"):
         E.ObjectRelocalizer(map_, camera, method="orb")
-    with pytest.raises(ValueError, match="policy: expected 'paper'"):
+    with pytest.raises(ValueError, match="policy: expected 'solid', 'paper'"):
         E.ObjectRelocalizer(map_, camera, policy="boxes")
     relocalizer = E.ObjectRelocalizer(map_, camera, acceptance={"enabled": False}, policy="bbox",
                                       search={"budget": E.SearchBudget()})

@@ -36,6 +36,7 @@ std::string ObserveOptions::validate() const {
       {"regular.max_corner_angle_deg", m.max_corner_angle_deg >= 0 && m.max_corner_angle_deg <= 180},
       {"regular.min_corner_angle_deg", m.min_corner_angle_deg >= 0 && m.min_corner_angle_deg <= m.max_corner_angle_deg},
       {"regular.min_pixels", m.min_pixels >= 0},
+      {"solid_min_solidity", solid_min_solidity >= 0 && solid_min_solidity <= 1},
   };
   for (const auto& [name, ok] : checks)
     if (!ok) return std::string("observe options: ") + name + " is out of range or not a number";
@@ -44,6 +45,8 @@ std::string ObserveOptions::validate() const {
 
 const char* toString(ObservationPolicy policy) {
   switch (policy) {
+    case ObservationPolicy::Solid:
+      return "solid";
     case ObservationPolicy::Paper:
       return "paper";
     case ObservationPolicy::Bbox:
@@ -57,8 +60,8 @@ const char* toString(ObservationPolicy policy) {
 }
 
 bool parseObservationPolicy(const std::string& name, ObservationPolicy* policy) {
-  for (ObservationPolicy p :
-       {ObservationPolicy::Paper, ObservationPolicy::Bbox, ObservationPolicy::Mask, ObservationPolicy::Given})
+  for (ObservationPolicy p : {ObservationPolicy::Solid, ObservationPolicy::Paper, ObservationPolicy::Bbox,
+                              ObservationPolicy::Mask, ObservationPolicy::Given})
     if (name == toString(p)) return *policy = p, true;
   return false;
 }
@@ -125,7 +128,9 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   const RegularVerdict verdict = testRegularMask(*mask, opt.regular);
   obs.regular = verdict.regular;
   obs.truncated = obs.truncated || verdict.touches_border;
-  if (opt.policy == ObservationPolicy::Paper && !verdict.regular) {
+  const bool solid = opt.policy == ObservationPolicy::Solid && verdict.solidity >= opt.solid_min_solidity;
+  if ((opt.policy == ObservationPolicy::Paper || opt.policy == ObservationPolicy::Solid) && !verdict.regular &&
+      !solid) {
     r.observation = obs;
     return r;
   }

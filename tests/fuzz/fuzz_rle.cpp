@@ -33,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   Detection d;
   d.bbox = Box(0, 0, rle.width, rle.height);
   d.mask = rle;
-  for (ObservationPolicy p : {ObservationPolicy::Paper, ObservationPolicy::Mask}) {
+  for (ObservationPolicy p : {ObservationPolicy::Paper, ObservationPolicy::Solid, ObservationPolicy::Mask}) {
     ObserveOptions o;
     o.policy = p;
     const ObserveResult r = observeDetection(d, rle.width, rle.height, o);

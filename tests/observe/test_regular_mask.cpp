@@ -183,16 +183,19 @@ TEST(Observe, PoliciesAndBadInput) {
   ObserveOptions bbox;
   bbox.policy = ObservationPolicy::Bbox;
   EXPECT_EQ(observeDetection(d, W, H, bbox).observation->source, EllipseSource::Box);
-  // An irregular mask under Paper: the box; under Mask: fitted.
+  // An irregular mask under Paper: the box; under Mask and Solid (it is solid): fitted.
   Detection round = d;
   round.mask = encodeMask(test::rasterEllipse(Ellipse({100, 70}, {40, 25}, 0.3), W, H));
-  EXPECT_EQ(observeDetection(round, W, H).observation->source, EllipseSource::Box);
+  ObserveOptions paper;
+  paper.policy = ObservationPolicy::Paper;
+  EXPECT_EQ(observeDetection(round, W, H, paper).observation->source, EllipseSource::Box);
+  EXPECT_EQ(observeDetection(round, W, H).observation->source, EllipseSource::Mask);
   ObserveOptions mask;
   mask.policy = ObservationPolicy::Mask;
   const ObserveResult rm = observeDetection(round, W, H, mask);
   EXPECT_EQ(rm.observation->source, EllipseSource::Mask);
   EXPECT_LT(wasserstein2(rm.observation->ellipse, Ellipse({100, 70}, {40, 25}, 0.3)), 1.0);
-  // A polygon stands for a mask under Paper and Mask, and gives the same observation.
+  // A polygon stands for a mask under Solid (the default) and Mask, and gives the same observation.
   Detection polygon = d;
   polygon.mask.reset();
   polygon.polygon = {{50, 40}, {150, 40}, {150, 100}, {50, 100}};
@@ -265,4 +268,54 @@ TEST(Observe, PoliciesAndBadInput) {
   edge.bbox = Box(-0.5, 10, 40, 60);
   edge.mask.reset();
   EXPECT_TRUE(observeDetection(edge, W, H).observation->truncated);
+}
+
+TEST(Observe, SolidPolicyFitsTheHullOfConvexSilhouettesOnly) {
+  const int W = 300, H = 200;
+  // A cuboid seen on a corner: a hexagonal silhouette, not a quadrilateral, and solid.
+  const std::vector<Eigen::Vector2d> hexagon = {{60, 60}, {120, 40}, {190, 55}, {200, 120}, {140, 150}, {70, 130}};
+  Detection box_like;
+  box_like.category_id = 73;
+  box_like.bbox = Box(59.5, 39.5, 200.5, 150.5);
+  box_like.mask = encodeMask(test::rasterPolygon(hexagon, W, H));
+  const RegularVerdict hex = testRegularMask(*box_like.mask);
+  ASSERT_FALSE(hex.regular);
+  ASSERT_GT(hex.solidity, 0.95);
+  const ObserveResult solid = observeDetection(box_like, W, H);  // Solid is the default
+  ASSERT_EQ(solid.status, ObserveStatus::Ok);
+  EXPECT_EQ(solid.observation->source, EllipseSource::Mask);
+  EXPECT_EQ(solid.observation->regular, std::optional<bool>(false));
+  const std::optional<Ellipse> hull = fitMaskEllipse(*box_like.mask, MaskFitMethod::Hull, &hex);
+  ASSERT_TRUE(hull.has_value());
+  EXPECT_LT(wasserstein2(solid.observation->ellipse, *hull), 1e-9);
+  ObserveOptions paper;
+  paper.policy = ObservationPolicy::Paper;
+  EXPECT_EQ(observeDetection(box_like, W, H, paper).observation->source, EllipseSource::Box);
+
+  // A chair-like outline (a seat and a back on thin legs) fills little of its hull: the box.
+  const std::vector<Eigen::Vector2d> chair = {{80, 20},  {110, 20},  {110, 100}, {190, 100}, {190, 180}, {182, 180},
+                                              {182, 115}, {108, 115}, {108, 180}, {100, 180}, {100, 115}, {80, 115}};
+  Detection composite = box_like;
+  composite.bbox = Box(79.5, 19.5, 190.5, 180.5);
+  composite.mask = encodeMask(test::rasterPolygon(chair, W, H));
+  const RegularVerdict legs = testRegularMask(*composite.mask);
+  ASSERT_LT(legs.solidity, ObserveOptions().solid_min_solidity);
+  EXPECT_EQ(observeDetection(composite, W, H).observation->source, EllipseSource::Box);
+
+  // The threshold is an option; 1 keeps the box for every non-regular mask, as Paper does.
+  ObserveOptions strict;
+  strict.solid_min_solidity = 1.0;
+  EXPECT_EQ(observeDetection(box_like, W, H, strict).observation->source, EllipseSource::Box);
+  ObserveOptions lax;
+  lax.solid_min_solidity = 0.0;
+  EXPECT_EQ(observeDetection(composite, W, H, lax).observation->source, EllipseSource::Mask);
+  ObserveOptions bad;
+  bad.solid_min_solidity = 1.5;
+  const ObserveResult refused = observeDetection(box_like, W, H, bad);
+  EXPECT_EQ(refused.status, ObserveStatus::InvalidOptions);
+  EXPECT_NE(refused.note.find("solid_min_solidity"), std::string::npos);
+  ObservationPolicy parsed;
+  ASSERT_TRUE(parseObservationPolicy("solid", &parsed));
+  EXPECT_EQ(parsed, ObservationPolicy::Solid);
+  EXPECT_STREQ(toString(ObservationPolicy::Solid), "solid");
 }

@@ -1,8 +1,10 @@
 #pragma once
 /// \file observe.hpp
-/// Turns a detection (box, optional mask or ellipse) into an observation ellipse, as the
-/// paper's relocalization does: a "regular" mask (a convex quadrilateral) gets an ellipse
-/// fitted to the mask, any other detection the ellipse inscribed in its box.
+/// Turns a detection (box, optional mask or ellipse) into an observation ellipse. The paper's
+/// relocalization fits an ellipse to a "regular" mask (a convex quadrilateral) and takes the
+/// ellipse inscribed in the box of any other detection; by default a solid non-regular mask
+/// (the silhouette of a convex object: a box seen on two or three faces, a cylinder) gets the
+/// hull fit as well.
 
 #include <optional>
 #include <string>
@@ -19,9 +21,10 @@ enum class ObservationPolicy {
   Bbox,   ///< always the box-inscribed ellipse (OA-SLAM)
   Mask,   ///< fit the mask whenever there is one
   Given,  ///< the detection's own `ellipse` field
+  Solid,  ///< Paper, and a solid non-regular mask (ObserveOptions::solid_min_solidity) -> its hull fit
 };
 
-/// Name <-> policy: "paper", "bbox", "mask", "given".
+/// Name <-> policy: "solid", "paper", "bbox", "mask", "given".
 const char* toString(ObservationPolicy policy);
 bool parseObservationPolicy(const std::string& name, ObservationPolicy* policy);
 
@@ -34,10 +37,15 @@ enum class MaskFitMethod {
 };
 
 struct ObserveOptions {
-  ObservationPolicy policy = ObservationPolicy::Paper;
+  ObservationPolicy policy = ObservationPolicy::Solid;
   MaskFitMethod regular_fit = MaskFitMethod::Quadrilateral;  ///< for regular masks
-  MaskFitMethod irregular_fit = MaskFitMethod::Hull;         ///< for other masks (policy Mask)
+  MaskFitMethod irregular_fit = MaskFitMethod::Hull;         ///< for other masks (policies Mask and Solid)
   RegularMaskOptions regular;
+  /// Policy Solid: a non-regular mask that covers at least this share of its convex hull
+  /// (RegularVerdict::solidity) outlines a convex solid, whose hull fit estimates the image of
+  /// the object's ellipsoid better than its box does. A composite object (a chair, a plant) or
+  /// a partly hidden one covers less of its hull, and its hull fit is no better than the box.
+  double solid_min_solidity = 0.8;
   double border_px = 2.0;  ///< a box this close to the image border is flagged truncated
 
   /// Empty when every threshold is finite and in range, else one line naming the first that
