@@ -47,6 +47,24 @@ def test_stub_members_exist():
                 cls = None
 
 
+def test_stub_classes_list_every_member():
+    """Each public member of a stubbed class is in its stub (scripts/python_stubs.py rewrites
+    them): a field or method added to the bindings without new stubs fails here."""
+    for stub, module in (("_ellreloc.pyi", _ellreloc), ("sim.pyi", ellreloc.sim)):
+        listed, cls = {}, None
+        for line in (PACKAGE / stub).read_text().splitlines():
+            if m := re.match(r"class (\w+)", line):
+                cls = m.group(1)
+                listed[cls] = set()
+            elif cls is not None and (m := re.match(r"    (?:def )?(\w+)\b", line)):
+                listed[cls].add(m.group(1))
+            elif line and not line.startswith(" "):
+                cls = None
+        for name, members in listed.items():
+            missing = {m for m in vars(getattr(module, name)) if not m.startswith("_")} - members
+            assert not missing, f"{stub}: {name} lacks {sorted(missing)}"
+
+
 def test_every_class_function_and_method_is_exercised_by_a_test():
     """Each public class, function and method is named in some test (fields are covered by the
     option round trips of test_surface.py)."""
