@@ -26,12 +26,12 @@ struct UnitGravity {
   double sigma_rad;
 };
 
-/// The camera-frame dual quadric of an ellipsoid at a pose: T Q* T^T with T = [R t; 0 1].
-Eigen::Matrix4d cameraDualQuadric(const Ellipsoid& e, const Pose& pose) {
+/// The camera-frame dual quadric of an ellipsoid (dual quadric Q) at a pose: T Q T^T with T = [R t; 0 1].
+Eigen::Matrix4d cameraDualQuadric(const Eigen::Matrix4d& Q, const Pose& pose) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
   T.topLeftCorner<3, 3>() = pose.rotation();
   T.topRightCorner<3, 1>() = pose.translation();
-  return T * e.dualQuadric() * T.transpose();
+  return T * Q * T.transpose();
 }
 
 /// Evaluates residuals (and optionally Jacobians w.r.t. the left perturbation
@@ -39,7 +39,8 @@ Eigen::Matrix4d cameraDualQuadric(const Ellipsoid& e, const Pose& pose) {
 struct Problem {
   const Intrinsics& K;
   std::vector<const EllipseMatch*> objects;
-  std::vector<double> object_scale;  // sqrt(a b) of each observed ellipse
+  std::vector<ProjectableEllipsoid> prepared;  // each object's ellipsoid, for its many projections
+  std::vector<double> object_scale;            // sqrt(a b) of each observed ellipse
   const std::vector<PointMatch>& points;
   const RefinerOptions& opt;
   const UnitGravity* gravity = nullptr;
@@ -52,8 +53,10 @@ struct Problem {
   /// Robust cost; false when an object no longer projects to an ellipse or a point is behind.
   bool cost(const Pose& pose, double* total) const {
     double sum = 0.0;
+    if (!objects.empty() && !pose.isValid()) return false;  // no projection, as project() says
+    const Eigen::Matrix<double, 3, 4> P = objects.empty() ? Eigen::Matrix<double, 3, 4>() : projectionMatrix(K, pose);
     for (size_t i = 0; i < objects.size(); ++i) {
-      const Projection p = project(objects[i]->ellipsoid, K, pose);
+      const Projection p = projectPrepared(prepared[i], P, pose);
       if (!p) return false;
       const double s = wasserstein2Squared(objects[i]->observed, p.ellipse) / (object_scale[i] * object_scale[i]);
       sum += robustLoss(opt.object_loss, opt.object_loss_scale, s);
@@ -89,7 +92,7 @@ struct Problem {
     M(0, 1) = -delta[2], M(0, 2) = delta[1], M(1, 0) = delta[2], M(1, 2) = -delta[0], M(2, 0) = -delta[1],
          M(2, 1) = delta[0];  // first-order Exp(omega) = I + [omega]x: exact for the derivative
     for (size_t i = 0; i < objects.size(); ++i) {
-      const Eigen::Matrix4d Qc = cameraDualQuadric(objects[i]->ellipsoid, pose);
+      const Eigen::Matrix4d Qc = cameraDualQuadric(prepared[i].dual_quadric, pose);
       const Eigen::Matrix<double, 4, 3> N = Qc.leftCols<3>() * Kd.transpose();
       const Eigen::Matrix3d C0 = Kd * N.topRows<3>();
       Mat3<Jet> C;
@@ -347,11 +350,12 @@ RefinementResult refinePose(const Intrinsics& K, const Pose& initial, const std:
   if (gravity)
     unit_gravity = UnitGravity{gravity->up_in_map.normalized(), gravity->up_in_camera.normalized(),
                                gravity->sigma_deg * M_PI / 180.0};
-  Problem problem{K, {}, {}, points, options, unit_gravity ? &*unit_gravity : nullptr};
+  Problem problem{K, {}, {}, {}, points, options, unit_gravity ? &*unit_gravity : nullptr};
   for (const EllipseMatch& m : objects) {
     if (!m.observed.isValid() || !(std::isfinite(m.sigma) && m.sigma > 0) || !project(m.ellipsoid, K, initial))
       continue;
     problem.objects.push_back(&m);
+    problem.prepared.emplace_back(m.ellipsoid);
     problem.object_scale.push_back(m.sigma * std::sqrt(m.observed.axes().prod()));
   }
   if (problem.objects.empty() && points.empty()) {
