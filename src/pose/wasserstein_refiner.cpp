@@ -54,7 +54,7 @@ struct Problem {
   bool cost(const Pose& pose, double* total) const {
     double sum = 0.0;
     if (!objects.empty() && !pose.isValid()) return false;  // no projection, as project() says
-    const Eigen::Matrix<double, 3, 4> P = objects.empty() ? Eigen::Matrix<double, 3, 4>() : projectionMatrix(K, pose);
+    const Eigen::Matrix<double, 3, 4> P = projectionMatrix(K, pose);
     for (size_t i = 0; i < objects.size(); ++i) {
       const Projection p = projectPrepared(prepared[i], P, pose);
       if (!p) return false;
