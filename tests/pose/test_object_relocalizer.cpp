@@ -3,6 +3,7 @@
 #include <thread>
 
 #include "ellreloc/core/projection.hpp"
+#include "ellreloc/error.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/sim/map_observations.hpp"
 #include "fixtures/random_geometry.hpp"
