@@ -10,8 +10,12 @@ cd "$(dirname "$0")/.."
 what="${1:-all}"
 jobs="$(nproc)"
 # -O1 without debug info: sanitizer builds compile several times slower than release ones.
+# Unity builds (CMake merges each target's sources eight at a time): the Eigen templates every
+# file instantiates are instantiated once per batch, which nearly halves the instrumented build
+# (ASan: 451 s against 833 s on 2 cores). So two source files of one target must not define the
+# same name at namespace scope, anonymous namespaces included; the release build stays per file.
 # No Python bindings: an instrumented extension needs the sanitizer runtime preloaded into python.
-common=(-G Ninja -DCMAKE_BUILD_TYPE= -DELLRELOC_BUILD_BENCHMARKS=OFF -DELLRELOC_PYTHON=OFF)
+common=(-G Ninja -DCMAKE_BUILD_TYPE= -DCMAKE_UNITY_BUILD=ON -DELLRELOC_BUILD_BENCHMARKS=OFF -DELLRELOC_PYTHON=OFF)
 export CC=clang-14 CXX=clang++-14
 start=$SECONDS
 

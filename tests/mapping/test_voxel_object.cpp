@@ -10,18 +10,18 @@
 namespace ellreloc {
 namespace {
 
-const Intrinsics kK(500.0, 500.0, 319.5, 239.5, 640, 480);
+const Intrinsics kVoxelCamera(500.0, 500.0, 319.5, 239.5, 640, 480);
 
 DepthImage flatDepth(float metres) {
   DepthImage d;
-  d.width = kK.width;
-  d.height = kK.height;
+  d.width = kVoxelCamera.width;
+  d.height = kVoxelCamera.height;
   d.metres.assign(static_cast<size_t>(d.width) * d.height, metres);
   return d;
 }
 
 BinaryMask rectMask(int x1, int y1, int x2, int y2) {
-  BinaryMask m(kK.height, kK.width);
+  BinaryMask m(kVoxelCamera.height, kVoxelCamera.width);
   for (int y = y1; y <= y2; ++y)
     for (int x = x1; x <= x2; ++x) m.at(x, y) = 1;
   return m;
@@ -35,11 +35,11 @@ TEST(VoxelObject, HitsFollowTheBayesFilterAndClamp) {
   const Pose camera;  // at the origin, looking along +z
   const BinaryMask mask = rectMask(300, 220, 340, 260);
   const Eigen::Vector3d on_plane(0.001, 0.001, 2.005);  // well inside one voxel
-  v.integrate(kK, camera, flatDepth(2.005f), mask);
+  v.integrate(kVoxelCamera, camera, flatDepth(2.005f), mask);
   EXPECT_NEAR(v.probabilityAt(on_plane), 0.7, 1e-6);
-  v.integrate(kK, camera, flatDepth(2.005f), mask);
+  v.integrate(kVoxelCamera, camera, flatDepth(2.005f), mask);
   EXPECT_NEAR(v.probabilityAt(on_plane), bayes(0.7, 0.7), 1e-6);
-  for (int i = 0; i < 20; ++i) v.integrate(kK, camera, flatDepth(2.005f), mask);
+  for (int i = 0; i < 20; ++i) v.integrate(kVoxelCamera, camera, flatDepth(2.005f), mask);
   EXPECT_NEAR(v.probabilityAt(on_plane), 0.97, 1e-6);                // OctoMap-style clamping
   EXPECT_DOUBLE_EQ(v.probabilityAt(Eigen::Vector3d(0, 0, 5)), 0.5);  // unknown
 }
@@ -50,17 +50,17 @@ TEST(VoxelObject, AbsorbingAnotherModelAddsItsEvidence) {
   // Two models of one plane from the same keyframe: fused, each voxel holds what one model
   // integrating that keyframe twice holds (eq. 1 with independent observations: log-odds add).
   VoxelObject a, b, twice;
-  a.integrate(kK, camera, flatDepth(2.005f), left);
-  b.integrate(kK, camera, flatDepth(2.005f), left);
-  twice.integrate(kK, camera, flatDepth(2.005f), left);
-  twice.integrate(kK, camera, flatDepth(2.005f), left);
+  a.integrate(kVoxelCamera, camera, flatDepth(2.005f), left);
+  b.integrate(kVoxelCamera, camera, flatDepth(2.005f), left);
+  twice.integrate(kVoxelCamera, camera, flatDepth(2.005f), left);
+  twice.integrate(kVoxelCamera, camera, flatDepth(2.005f), left);
   a.absorb(b);
   ASSERT_EQ(a.size(), twice.size());
   for (const Eigen::Vector3d& c : twice.occupiedCentres(0.01))
     EXPECT_NEAR(a.probabilityAt(c), twice.probabilityAt(c), 1e-6);
   // A model of another part of the object: its voxels join with their own evidence.
   VoxelObject other;
-  other.integrate(kK, camera, flatDepth(2.005f), right);
+  other.integrate(kVoxelCamera, camera, flatDepth(2.005f), right);
   a.absorb(other);
   EXPECT_EQ(a.size(), twice.size() + other.size());
   for (const Eigen::Vector3d& c : other.occupiedCentres(0.01)) EXPECT_NEAR(a.probabilityAt(c), 0.7, 1e-6);
@@ -73,7 +73,7 @@ TEST(VoxelObject, VoxelsLieOnTheBackProjectedSurfaceAndProjectToTheMask) {
   VoxelObject v;
   const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
   const BinaryMask mask = rectMask(250, 200, 390, 300);
-  const auto up = v.integrate(kK, camera, flatDepth(2.5f), mask);
+  const auto up = v.integrate(kVoxelCamera, camera, flatDepth(2.5f), mask);
   EXPECT_EQ(up.hits, up.added);
   ASSERT_GT(v.size(), 100u);
   const double half_diagonal = std::sqrt(3.0) * 0.5 * v.options().voxel_size;
@@ -81,7 +81,7 @@ TEST(VoxelObject, VoxelsLieOnTheBackProjectedSurfaceAndProjectToTheMask) {
     // Independent check: the voxel centre is within half a voxel diagonal of the plane z_c = 2.5.
     EXPECT_LE(std::abs(camera.transform(c).z() - 2.5), half_diagonal + 1e-9);
   }
-  const auto box = v.projectedBox(kK, camera);
+  const auto box = v.projectedBox(kVoxelCamera, camera);
   ASSERT_TRUE(box);
   const double voxel_px = 500.0 * v.options().voxel_size / 2.5;  // one voxel at that depth
   EXPECT_NEAR(box->x1, 250, voxel_px);
@@ -96,7 +96,7 @@ TEST(VoxelObject, VoxelsLieOnTheBackProjectedSurfaceAndProjectToTheMask) {
 TEST(VoxelObject, PointMeansLieOnTheSurface) {
   VoxelObject v;
   const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
-  v.integrate(kK, camera, flatDepth(2.5f), rectMask(250, 200, 390, 300));
+  v.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 390, 300));
   const std::vector<Eigen::Vector3d> means = v.occupiedPointMeans(), centres = v.occupiedCentres();
   ASSERT_EQ(means.size(), centres.size());
   ASSERT_GT(means.size(), 100u);
@@ -114,8 +114,8 @@ TEST(VoxelObject, PointMeansLieOnTheSurface) {
   // mean is 2.0031 + 3/4 of the way to 2.0071 wherever both models hold it evenly.
   VoxelObject a, b;
   const BinaryMask mask = rectMask(300, 220, 340, 260);
-  a.integrate(kK, Pose(), flatDepth(2.0031f), mask);
-  for (int i = 0; i < 3; ++i) b.integrate(kK, Pose(), flatDepth(2.0071f), mask);
+  a.integrate(kVoxelCamera, Pose(), flatDepth(2.0031f), mask);
+  for (int i = 0; i < 3; ++i) b.integrate(kVoxelCamera, Pose(), flatDepth(2.0071f), mask);
   a.absorb(b);
   std::vector<double> z;
   for (const Eigen::Vector3d& m : a.occupiedPointMeans(0.01)) {
@@ -135,27 +135,27 @@ TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {
   const Eigen::Vector3d right(0.071, 0.001, 2.005);
   {
     VoxelObject v;
-    v.integrate(kK, camera, flatDepth(2.005f), full);
-    v.integrate(kK, camera, flatDepth(2.005f), rectMask(320, 220, 340, 260));
+    v.integrate(kVoxelCamera, camera, flatDepth(2.005f), full);
+    v.integrate(kVoxelCamera, camera, flatDepth(2.005f), rectMask(320, 220, 340, 260));
     EXPECT_NEAR(v.probabilityAt(left), bayes(0.7, 0.3), 1e-6);  // seen outside the mask
     EXPECT_NEAR(v.probabilityAt(right), bayes(0.7, 0.7), 1e-6);
   }
   {
     VoxelObject v;
-    v.integrate(kK, camera, flatDepth(2.005f), full);
-    v.integrate(kK, camera, flatDepth(3.005f), full);  // the surface moved back: free space
+    v.integrate(kVoxelCamera, camera, flatDepth(2.005f), full);
+    v.integrate(kVoxelCamera, camera, flatDepth(3.005f), full);  // the surface moved back: free space
     EXPECT_NEAR(v.probabilityAt(left), bayes(0.7, 0.3), 1e-6);
   }
   {
     VoxelObject v;
-    v.integrate(kK, camera, flatDepth(2.005f), full);
-    v.integrate(kK, camera, flatDepth(1.0f), rectMask(0, 0, 10, 10));  // something in front hides it
+    v.integrate(kVoxelCamera, camera, flatDepth(2.005f), full);
+    v.integrate(kVoxelCamera, camera, flatDepth(1.0f), rectMask(0, 0, 10, 10));  // something in front hides it
     EXPECT_NEAR(v.probabilityAt(left), 0.7, 1e-6);
   }
   {
     VoxelObject v;
-    v.integrate(kK, camera, flatDepth(2.005f), full);
-    const auto up = v.integrate(kK, camera, flatDepth(0.0f), rectMask(0, 0, 10, 10));  // no reading
+    v.integrate(kVoxelCamera, camera, flatDepth(2.005f), full);
+    const auto up = v.integrate(kVoxelCamera, camera, flatDepth(0.0f), rectMask(0, 0, 10, 10));  // no reading
     EXPECT_EQ(up.hits + up.misses, 0);
     EXPECT_NEAR(v.probabilityAt(left), 0.7, 1e-6);
   }
@@ -163,23 +163,23 @@ TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {
 
 TEST(VoxelObject, DepthGateDropsMaskPixelsOnTheBackground) {
   DepthImage depth = flatDepth(2.005f);
-  for (int y = 0; y < kK.height; ++y)
-    for (int x = 0; x < 310; ++x) depth.metres[static_cast<size_t>(y) * kK.width + x] = 4.0f;  // a wall behind
+  for (int y = 0; y < kVoxelCamera.height; ++y)
+    for (int x = 0; x < 310; ++x) depth.metres[static_cast<size_t>(y) * kVoxelCamera.width + x] = 4.0f;  // a wall behind
   VoxelObject v;
-  v.integrate(kK, Pose(), depth, rectMask(300, 220, 360, 260));  // a sixth of the mask bleeds onto the wall
+  v.integrate(kVoxelCamera, Pose(), depth, rectMask(300, 220, 360, 260));  // a sixth of the mask bleeds onto the wall
   for (const Eigen::Vector3d& c : v.occupiedCentres()) EXPECT_LT(c.z(), 2.1);
   VoxelOptions no_gate;
   no_gate.depth_gate_sigmas = 0.0;
   VoxelObject w(no_gate);
-  w.integrate(kK, Pose(), depth, rectMask(300, 220, 360, 260));
+  w.integrate(kVoxelCamera, Pose(), depth, rectMask(300, 220, 360, 260));
   EXPECT_GT(w.size(), v.size());
 }
 
 TEST(VoxelObject, CountNearIsEquationFourCounting) {
   VoxelObject a, b, far;
-  a.integrate(kK, Pose(), flatDepth(2.005f), rectMask(300, 220, 340, 260));
-  b.integrate(kK, Pose(), flatDepth(2.005f), rectMask(320, 220, 360, 260));  // half overlapping
-  far.integrate(kK, Pose(), flatDepth(3.005f), rectMask(300, 220, 340, 260));
+  a.integrate(kVoxelCamera, Pose(), flatDepth(2.005f), rectMask(300, 220, 340, 260));
+  b.integrate(kVoxelCamera, Pose(), flatDepth(2.005f), rectMask(320, 220, 360, 260));  // half overlapping
+  far.integrate(kVoxelCamera, Pose(), flatDepth(3.005f), rectMask(300, 220, 340, 260));
   const long n = static_cast<long>(a.occupiedCount());
   EXPECT_EQ(a.countNear(a, 0.0), n);
   EXPECT_EQ(a.countNear(far, 0.05), 0);
@@ -202,12 +202,12 @@ TEST(VoxelObject, PruneAndMemoryBudget) {
   VoxelOptions small;
   small.max_voxels = 100;
   VoxelObject v(small);
-  v.integrate(kK, Pose(), flatDepth(2.005f), rectMask(200, 200, 400, 300));
+  v.integrate(kVoxelCamera, Pose(), flatDepth(2.005f), rectMask(200, 200, 400, 300));
   EXPECT_LE(v.size(), 100u);
   EXPECT_GT(v.memoryBytes(), 100u * 8u);
   VoxelObject w;
-  w.integrate(kK, Pose(), flatDepth(2.005f), rectMask(300, 220, 340, 260));
-  w.integrate(kK, Pose(), flatDepth(2.005f), rectMask(320, 220, 340, 260));
+  w.integrate(kVoxelCamera, Pose(), flatDepth(2.005f), rectMask(300, 220, 340, 260));
+  w.integrate(kVoxelCamera, Pose(), flatDepth(2.005f), rectMask(320, 220, 340, 260));
   const size_t before = w.size();
   const size_t removed = w.prune(0.6);  // the left half dropped to 0.5
   EXPECT_GT(removed, 0u);
@@ -219,16 +219,16 @@ TEST(VoxelObject, BadInputIsAnErrorNotACrash) {
   VoxelObject v;
   const BinaryMask mask = rectMask(300, 220, 340, 260);
   BinaryMask wrong(240, 320);
-  EXPECT_THROW(v.integrate(kK, Pose(), flatDepth(2.005f), wrong), Error);
+  EXPECT_THROW(v.integrate(kVoxelCamera, Pose(), flatDepth(2.005f), wrong), Error);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(v.integrate(kK, Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0)), flatDepth(2.005f), mask),
+  EXPECT_THROW(v.integrate(kVoxelCamera, Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0)), flatDepth(2.005f), mask),
                Error);
   DepthImage small = flatDepth(2.005f);
   small.width = 320;
-  EXPECT_THROW(v.integrate(kK, Pose(), small, mask), Error);
+  EXPECT_THROW(v.integrate(kVoxelCamera, Pose(), small, mask), Error);
   EXPECT_EQ(v.size(), 0u);
   DepthImage nan_depth = flatDepth(std::numeric_limits<float>::quiet_NaN());
-  EXPECT_EQ(v.integrate(kK, Pose(), nan_depth, mask).hits, 0);
+  EXPECT_EQ(v.integrate(kVoxelCamera, Pose(), nan_depth, mask).hits, 0);
 }
 
 TEST(VoxelObject, MajorityFilterAndBoxMasks) {
