@@ -9,10 +9,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 dir=build-asan
 if [ ! -x "$dir/tests/fuzz/fuzz_rle" ]; then
-  CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE= -DELLRELOC_BUILD_BENCHMARKS=OFF \
-    -DELLRELOC_BUILD_FUZZERS=ON -DELLRELOC_PYTHON=OFF \
-    -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer" \
-    >/dev/null
+  scripts/sanitize.sh configure-asan
   cmake --build "$dir" -j "$(nproc)" --target fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer
 fi
 mkdir -p "$dir/artifacts"

@@ -4,10 +4,15 @@
 #         aborts), in build-asan/. The same build holds the libFuzzer targets (scripts/fuzz.sh
 #         uses it), so one instrumented build serves both.
 #   tsan: the concurrency tests under ThreadSanitizer, in build-tsan/.
-#   scripts/sanitize.sh [asan|tsan|all]
+#   configure-asan: only configures build-asan/ (scripts/fuzz.sh builds its fuzzers there).
+#   scripts/sanitize.sh [asan|tsan|all|configure-asan]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what="${1:-all}"
+case "$what" in
+  asan | tsan | all | configure-asan) ;;
+  *) echo "sanitize: unknown stage '$what' (asan, tsan, all or configure-asan)" >&2; exit 2 ;;
+esac
 jobs="$(nproc)"
 # -O1 without debug info: sanitizer builds compile several times slower than release ones.
 # Unity builds (CMake merges each target's sources eight at a time): the Eigen templates every
@@ -19,10 +24,14 @@ common=(-G Ninja -DCMAKE_BUILD_TYPE= -DCMAKE_UNITY_BUILD=ON -DELLRELOC_BUILD_BEN
 export CC=clang-14 CXX=clang++-14
 start=$SECONDS
 
-if [ "$what" = asan ] || [ "$what" = all ]; then
+if [ "$what" != tsan ]; then
   cmake -S . -B build-asan "${common[@]}" -DELLRELOC_BUILD_FUZZERS=ON \
     -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer" \
     >/dev/null
+fi
+if [ "$what" = configure-asan ]; then exit 0; fi
+
+if [ "$what" = asan ] || [ "$what" = all ]; then
   cmake --build build-asan -j "$jobs"
   echo "sanitize: asan build done after $((SECONDS - start)) s"
   # Left out: the packaging test (installs and rebuilds the examples: nothing to sanitize) and
