@@ -42,10 +42,12 @@ struct ObserveOptions {
   MaskFitMethod irregular_fit = MaskFitMethod::Hull;         ///< for other masks (policies Mask and Solid)
   RegularMaskOptions regular;
   /// Policy Solid: a non-regular mask that covers at least this share of its convex hull
-  /// (RegularVerdict::solidity) outlines a convex solid, whose hull fit estimates the image of
-  /// the object's ellipsoid better than its box does. A composite object (a chair, a plant) or
-  /// a partly hidden one covers less of its hull, and its hull fit is no better than the box.
-  double solid_min_solidity = 0.8;
+  /// (RegularVerdict::solidity) gets its hull fit. The silhouette of a convex solid fills its
+  /// hull; that of a composite object seen whole (a chair, a plant: about half to four fifths)
+  /// has a hull close to its cuboid's silhouette, and the hull fit estimates the image of the
+  /// object's ellipsoid better than the box does for both. A mask covering less than half its
+  /// hull is mostly gaps (thin parts, fragments of a partly hidden object): it keeps the box.
+  double solid_min_solidity = 0.5;
   double border_px = 2.0;  ///< a box this close to the image border is flagged truncated
 
   /// Empty when every threshold is finite and in range, else one line naming the first that
