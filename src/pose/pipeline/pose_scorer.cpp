@@ -39,6 +39,7 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
       label_weight_[i].push_back(weigh ? std::min(1.0, m.categoryShare(observations[i].category) / 0.5) : 1.0);
     }
   projected_.resize(map.objects.size());
+  projected_box_.resize(map.objects.size());
   projects_.resize(map.objects.size(), 0);
   observation_taken_.resize(observations.size());
   object_taken_.resize(map.objects.size());
@@ -90,7 +91,7 @@ void PoseScorer::forEachNearbyPair(F f) const {
     for (size_t c = 0; c < cands.size(); ++c) {
       const int j = cands[c];
       if (!projects_[j]) continue;
-      const Box pb = projected_[j].boundingBox();
+      const Box& pb = projected_box_[j];
       if (pb.x2 <= o.box.x1 || o.box.x2 <= pb.x1 || pb.y2 <= o.box.y1 || o.box.y2 <= pb.y1) continue;
       f(i, c, j);
     }
@@ -104,7 +105,7 @@ double PoseScorer::costLowerBound(int vertices) {
   forEachNearbyPair([&](size_t i, size_t c, int j) {
     const Observation& o = observations_[i];
     const double ub = options_.overlap == OverlapMeasure::BoxIoU
-                          ? boxIoU(o.box, projected_[j].boundingBox())
+                          ? boxIoU(o.box, projected_box_[j])
                           : ellipseIoUUpperBound(o.ellipse, projected_[j], vertices);
     pair_bounds_.push_back(ub);
     if (ub < options_.min_overlap - 1e-9) return;
@@ -124,6 +125,7 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     if (known && k != known->objects + known->count) {
       projects_[j] = 1;
       projected_[j] = known->ellipses[k - known->objects];
+      projected_box_[j] = projected_[j].boundingBox();
       continue;
     }
     // Most objects are out of view at most poses: a cheap test spares their projection.
@@ -136,7 +138,10 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     }
     const Projection p = valid ? projectPrepared(e, P, pose) : Projection{};
     projects_[j] = p.ok();
-    if (p.ok()) projected_[j] = p.ellipse;
+    if (p.ok()) {
+      projected_[j] = p.ellipse;
+      projected_box_[j] = p.ellipse.boundingBox();
+    }
   }
   // Most hypotheses are far worse than those kept: bounds show it without an exact overlap.
   const bool bounded = give_up_at < std::numeric_limits<double>::infinity();

@@ -86,6 +86,7 @@ class PoseScorer {
   std::vector<std::vector<double>> label_weight_;  // per observation, per candidate
   // Scratch, reused across calls.
   std::vector<Ellipse> projected_;
+  std::vector<Box> projected_box_;  // the bounding box of each projected_ ellipse
   std::vector<char> projects_;
   std::vector<ObjectCorrespondence> all_matches_;
   std::vector<char> observation_taken_, object_taken_;
