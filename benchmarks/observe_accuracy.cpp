@@ -53,24 +53,7 @@ bool render(const std::vector<Part>& parts, const Pose& pose, BinaryMask* mask) 
       if (xc(2) < 0.05) return false;
       img.push_back(kK.project(xc));
     }
-    // Convex hull (monotone chain) of the projected points.
-    std::sort(img.begin(), img.end(),
-              [](const auto& a, const auto& b) { return a(0) < b(0) || (a(0) == b(0) && a(1) < b(1)); });
-    std::vector<Eigen::Vector2d> hull;
-    auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-      return (a(0) - o(0)) * (b(1) - o(1)) - (a(1) - o(1)) * (b(0) - o(0));
-    };
-    for (int pass = 0; pass < 2; ++pass) {
-      const size_t start = hull.size();
-      for (size_t i = 0; i < img.size(); ++i) {
-        const auto& p = pass == 0 ? img[i] : img[img.size() - 1 - i];
-        while (hull.size() >= start + 2 && cross(hull[hull.size() - 2], hull.back(), p) <= 0) hull.pop_back();
-        hull.push_back(p);
-      }
-      hull.pop_back();
-    }
-    const BinaryMask part_mask = test::rasterPolygon(hull, kK.width, kK.height);
-    for (size_t i = 0; i < mask->data.size(); ++i) mask->data[i] |= part_mask.data[i];
+    test::addConvexHull(img, *mask);
   }
   return true;
 }

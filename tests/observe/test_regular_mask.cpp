@@ -332,30 +332,6 @@ TEST(Observe, SolidPolicyFitsTheHullOfConvexSilhouettesOnly) {
   EXPECT_STREQ(toString(ObservationPolicy::Solid), "solid");
 }
 
-namespace {
-
-/// The convex hull (counter-clockwise) of points, by the monotone chain.
-Poly convexHull(Poly p) {
-  std::sort(p.begin(), p.end(),
-            [](const auto& a, const auto& b) { return a(0) < b(0) || (a(0) == b(0) && a(1) < b(1)); });
-  const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return (a(0) - o(0)) * (b(1) - o(1)) - (a(1) - o(1)) * (b(0) - o(0));
-  };
-  Poly hull;
-  for (int pass = 0; pass < 2; ++pass) {
-    const size_t start = hull.size();
-    for (size_t i = 0; i < p.size(); ++i) {
-      const auto& q = pass == 0 ? p[i] : p[p.size() - 1 - i];
-      while (hull.size() >= start + 2 && cross(hull[hull.size() - 2], hull.back(), q) <= 0) hull.pop_back();
-      hull.push_back(q);
-    }
-    hull.pop_back();
-  }
-  return hull;
-}
-
-}  // namespace
-
 TEST(Observe, SolidPolicyFitsTheHullOfAChairSeenWhole) {
   // A chair (seat, back and four legs, each a cuboid) seen whole from around it: its mask fills
   // half to four fifths of its hull, which spans about the silhouette of the chair's cuboid.
@@ -385,8 +361,7 @@ TEST(Observe, SolidPolicyFitsTheHullOfAChairSeenWhole) {
         corners.push_back(K.project(pose.transform(
             centre + Eigen::Vector3d((k & 1 ? 1 : -1) * extent(0), (k & 2 ? 1 : -1) * extent(1),
                                      (k & 4 ? 1 : -1) * extent(2)))));
-      const BinaryMask part = test::rasterPolygon(convexHull(corners), K.width, K.height);
-      for (size_t i = 0; i < mask.data.size(); ++i) mask.data[i] |= part.data[i];
+      test::addConvexHull(corners, mask);
     }
     Detection chair;
     chair.category_id = 56;
