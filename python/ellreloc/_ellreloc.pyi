@@ -497,11 +497,14 @@ class RegularMaskOptions:
     max_corner_angle_deg: float
     min_corner_angle_deg: float
     min_pixels: int
+    outline_tolerance: float
 
 
 class RegularVerdict:
     """The regular-mask test's verdict and its diagnostics."""
     regular: bool
+    quadrilateral: bool
+    outline_vertices: int
     hull_vertices: int
     quad_vertices: int
     solidity: float

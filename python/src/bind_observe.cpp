@@ -50,7 +50,8 @@ void bindOptions(py::module_& m) {
       .def_readwrite("min_core_fill", &RegularMaskOptions::min_core_fill)
       .def_readwrite("max_corner_angle_deg", &RegularMaskOptions::max_corner_angle_deg)
       .def_readwrite("min_corner_angle_deg", &RegularMaskOptions::min_corner_angle_deg)
-      .def_readwrite("min_pixels", &RegularMaskOptions::min_pixels);
+      .def_readwrite("min_pixels", &RegularMaskOptions::min_pixels)
+      .def_readwrite("outline_tolerance", &RegularMaskOptions::outline_tolerance);
   py::class_<ObserveOptions>(m, "ObserveOptions")
       .def(py::init<>())
       .def_readwrite("policy", &ObserveOptions::policy)
@@ -58,8 +59,9 @@ void bindOptions(py::module_& m) {
       .def_readwrite("irregular_fit", &ObserveOptions::irregular_fit)
       .def_readwrite("regular", &ObserveOptions::regular)
       .def_readwrite("border_px", &ObserveOptions::border_px)
-      .def_readwrite("solid_min_solidity", &ObserveOptions::solid_min_solidity,
-                     "policy 'solid': a non-regular mask covering at least this share of its convex hull gets the hull fit")
+      .def_readwrite(
+          "solid_min_solidity", &ObserveOptions::solid_min_solidity,
+          "policy 'solid': a non-regular mask covering at least this share of its convex hull gets the hull fit")
       .def("validate", &ObserveOptions::validate, "'' when every threshold is in range, else the first that is not.");
 }
 
@@ -74,7 +76,11 @@ void bindResults(py::module_& m) {
       .def_readonly("observation", &ObserveResult::observation, "None when there is none.")
       .def_readonly("note", &ObserveResult::note, "Why the mask was not used when the policy wanted it.");
   py::class_<RegularVerdict>(m, "RegularVerdict", "The regular-mask test's verdict and its diagnostics.")
-      .def_readonly("regular", &RegularVerdict::regular)
+      .def_readonly("regular", &RegularVerdict::regular, "both tests pass: the paper's regular object")
+      .def_readonly("quadrilateral", &RegularVerdict::quadrilateral,
+                    "the quadrilateral test passes: the four-corner quadrilateral describes the mask")
+      .def_readonly("outline_vertices", &RegularVerdict::outline_vertices,
+                    "vertices of the outline reduced by Douglas-Peucker (0 when the quadrilateral test failed)")
       .def_readonly("hull_vertices", &RegularVerdict::hull_vertices)
       .def_readonly("quad_vertices", &RegularVerdict::quad_vertices)
       .def_readonly("solidity", &RegularVerdict::solidity)

@@ -36,6 +36,7 @@ std::string ObserveOptions::validate() const {
       {"regular.max_corner_angle_deg", m.max_corner_angle_deg >= 0 && m.max_corner_angle_deg <= 180},
       {"regular.min_corner_angle_deg", m.min_corner_angle_deg >= 0 && m.min_corner_angle_deg <= m.max_corner_angle_deg},
       {"regular.min_pixels", m.min_pixels >= 0},
+      {"regular.outline_tolerance", m.outline_tolerance >= 0 && m.outline_tolerance < 1},
       {"solid_min_solidity", solid_min_solidity >= 0 && solid_min_solidity <= 1},
   };
   for (const auto& [name, ok] : checks)
@@ -128,13 +129,18 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   const RegularVerdict verdict = testRegularMask(*mask, opt.regular);
   obs.regular = verdict.regular;
   obs.truncated = obs.truncated || verdict.touches_border;
+  // The paper fits only its regular masks. The other policies choose the fit by what describes
+  // the mask: the quadrilateral's ellipse when the quadrilateral test passes (also for a box seen
+  // with a sliver of a second face, which the outline test turns down but whose quadrilateral
+  // still describes it better than its hull does), else the hull's.
+  const bool paper = opt.policy == ObservationPolicy::Paper;
+  const bool quadrilateral = paper ? verdict.regular : verdict.quadrilateral;
   const bool solid = opt.policy == ObservationPolicy::Solid && verdict.solidity >= opt.solid_min_solidity;
-  if ((opt.policy == ObservationPolicy::Paper || opt.policy == ObservationPolicy::Solid) && !verdict.regular &&
-      !solid) {
+  if ((paper || opt.policy == ObservationPolicy::Solid) && !quadrilateral && !solid) {
     r.observation = obs;
     return r;
   }
-  const MaskFitMethod method = verdict.regular ? opt.regular_fit : opt.irregular_fit;
+  const MaskFitMethod method = quadrilateral ? opt.regular_fit : opt.irregular_fit;
   std::optional<Ellipse> fitted = fitMaskEllipse(*mask, method, &verdict);
   if (!fitted && method != MaskFitMethod::Moments) fitted = fitMaskEllipse(*mask, MaskFitMethod::Moments, &verdict);
   if (!fitted || !fitted->isValid()) {

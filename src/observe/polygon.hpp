@@ -99,4 +99,93 @@ inline std::vector<Point> hullOfColumns(const std::vector<MaskColumn>& cols) {
   return hull;
 }
 
+/// The outline of a mask with every column filled between its extreme rows, through pixel
+/// centres: each column's top row left to right, then its bottom row right to left (a closed
+/// ring; the vertical sides of the first and last columns are its closing edges).
+inline std::vector<Point> columnOutline(const std::vector<MaskColumn>& cols) {
+  std::vector<Point> ring;
+  ring.reserve(2 * cols.size());
+  for (const MaskColumn& c : cols) ring.emplace_back(c.x, c.ymin);
+  for (auto it = cols.rbegin(); it != cols.rend(); ++it) ring.emplace_back(it->x, it->ymax);
+  return ring;
+}
+
+/// Douglas-Peucker on a closed ring, as cv::approxPolyDP does for a closed curve: split the
+/// ring at two far-apart points (the farthest from the first point, and the farthest from that
+/// one), then keep, recursively, the point of each chain farthest from the line through its
+/// ends while that distance exceeds `epsilon`, and finally drop the kept points that lie close to
+/// the line through their neighbours. Returns the kept points in ring order.
+inline std::vector<Point> douglasPeuckerRing(const std::vector<Point>& ring, double epsilon) {
+  const size_t n = ring.size();
+  if (n < 3) return ring;
+  auto farthestFrom = [&](size_t from) {
+    size_t best = from;
+    double best_d = -1.0;
+    for (size_t i = 0; i < n; ++i)
+      if (const double d = (ring[i] - ring[from]).squaredNorm(); d > best_d) best_d = d, best = i;
+    return best;
+  };
+  const size_t a = farthestFrom(0), b = farthestFrom(a);
+  if (a == b) return {ring[a]};
+  std::vector<bool> keep(n, false);
+  keep[a] = keep[b] = true;
+  // Chains as (first, last) ring indices walked forward; an explicit stack, no recursion.
+  std::vector<std::pair<size_t, size_t>> stack = {{a, b}, {b, a}};
+  while (!stack.empty()) {
+    const auto [first, last] = stack.back();
+    stack.pop_back();
+    const Point& p = ring[first];
+    const Point d = ring[last] - p;
+    const double len = d.norm();
+    size_t best = first;
+    double best_dist = epsilon;
+    for (size_t i = (first + 1) % n; i != last; i = (i + 1) % n) {
+      const Point q = ring[i] - p;
+      const double dist = len > 1e-12 ? std::abs(d(0) * q(1) - d(1) * q(0)) / len : q.norm();
+      if (dist > best_dist) best_dist = dist, best = i;
+    }
+    if (best == first) continue;
+    keep[best] = true;
+    stack.push_back({first, best});
+    stack.push_back({best, last});
+  }
+  std::vector<Point> out;
+  for (size_t i = 0; i < n; ++i)
+    if (keep[i]) out.push_back(ring[i]);
+  // The two split points are kept whatever their place: one pass drops each kept point that
+  // lies between its kept neighbours and within epsilon / sqrt(2) of the line through them (the
+  // last step of cv::approxPolyDP for closed curves).
+  for (size_t i = 0; i < out.size() && out.size() > 3;) {
+    const Point& prev = out[(i + out.size() - 1) % out.size()];
+    const Point& next = out[(i + 1) % out.size()];
+    const Point d = next - prev, q = out[i] - prev;
+    const double cross = d(0) * q(1) - d(1) * q(0);
+    if (cross * cross <= 0.5 * epsilon * epsilon * d.squaredNorm() && q.dot(next - out[i]) >= 0)
+      out.erase(out.begin() + static_cast<std::ptrdiff_t>(i));
+    else
+      ++i;
+  }
+  return out;
+}
+
+/// Length of a closed ring.
+inline double ringLength(const std::vector<Point>& ring) {
+  double length = 0.0;
+  for (size_t i = 0; i < ring.size(); ++i) length += (ring[(i + 1) % ring.size()] - ring[i]).norm();
+  return length;
+}
+
+/// True when every turn of the closed polygon goes the same way (collinear vertices allowed).
+inline bool isConvexPolygon(const std::vector<Point>& p) {
+  if (p.size() < 3) return false;
+  int sign = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const double c = cross(p[i], p[(i + 1) % p.size()], p[(i + 2) % p.size()]);
+    const int s = c > 0 ? 1 : c < 0 ? -1 : 0;
+    if (s != 0 && sign != 0 && s != sign) return false;
+    if (s != 0) sign = s;
+  }
+  return sign != 0;
+}
+
 }  // namespace ellreloc::polygon

@@ -66,6 +66,16 @@ long pixelsInside(const RleMask& rle, const std::vector<Point>& q) {
   return n;
 }
 
+/// The outline test on a mask's columns.
+int outlineVerticesOf(const std::vector<MaskColumn>& cols, double tolerance, bool* convex) {
+  if (convex) *convex = false;
+  if (cols.empty()) return 0;
+  const std::vector<Point> ring = polygon::columnOutline(cols);
+  const std::vector<Point> reduced = polygon::douglasPeuckerRing(ring, tolerance * polygon::ringLength(ring));
+  if (convex) *convex = polygon::isConvexPolygon(reduced);
+  return static_cast<int>(reduced.size());
+}
+
 }  // namespace
 
 std::vector<MaskColumn> rleColumns(const RleMask& rle) {
@@ -119,11 +129,19 @@ RegularVerdict testRegularMask(const RleMask& rle, const RegularMaskOptions& opt
                     ? static_cast<double>(pixelsInside(rle, core)) / polygonArea(core)
                     : 1.0;  // too thin to have a core: judged by `fill` alone
   const bool triangle = v.triangle_fill >= options.min_fill && v.triangle_fill <= options.max_fill;
-  v.regular = !triangle && v.core_fill >= options.min_core_fill && v.solidity >= options.min_solidity &&
-              v.fill >= options.min_fill && v.fill <= options.max_fill &&
-              v.max_corner_angle_deg <= options.max_corner_angle_deg &&
-              v.min_corner_angle_deg >= options.min_corner_angle_deg;
+  v.quadrilateral = !triangle && v.core_fill >= options.min_core_fill && v.solidity >= options.min_solidity &&
+                    v.fill >= options.min_fill && v.fill <= options.max_fill &&
+                    v.max_corner_angle_deg <= options.max_corner_angle_deg &&
+                    v.min_corner_angle_deg >= options.min_corner_angle_deg;
+  if (!v.quadrilateral) return v;
+  bool convex = false;
+  v.outline_vertices = outlineVerticesOf(cols, options.outline_tolerance, &convex);
+  v.regular = v.outline_vertices == 4 && convex;
   return v;
+}
+
+int outlineVertices(const RleMask& rle, double tolerance, bool* convex) {
+  return outlineVerticesOf(rleColumns(rle), tolerance, convex);
 }
 
 std::vector<Eigen::Vector2d> rleConvexHull(const RleMask& rle) { return polygon::hullOfColumns(rleColumns(rle)); }

@@ -2,9 +2,10 @@
 /// \file observe.hpp
 /// Turns a detection (box, optional mask or ellipse) into an observation ellipse. The paper's
 /// relocalization fits an ellipse to a "regular" mask (a convex quadrilateral) and takes the
-/// ellipse inscribed in the box of any other detection; by default a solid non-regular mask
-/// (the silhouette of a convex object: a box seen on two or three faces, a cylinder) gets the
-/// hull fit as well.
+/// ellipse inscribed in the box of any other detection. By default a mask its four-corner
+/// quadrilateral describes (regular, or a box seen with a sliver of a second face) gets the
+/// quadrilateral's ellipse, and another solid mask (the silhouette of a convex object: a box
+/// seen on two or three faces, a cylinder; a chair seen whole) the hull fit.
 
 #include <optional>
 #include <string>
@@ -21,7 +22,10 @@ enum class ObservationPolicy {
   Bbox,   ///< always the box-inscribed ellipse (OA-SLAM)
   Mask,   ///< fit the mask whenever there is one
   Given,  ///< the detection's own `ellipse` field
-  Solid,  ///< Paper, and a solid non-regular mask (ObserveOptions::solid_min_solidity) -> its hull fit
+  /// a mask that passes the quadrilateral test (RegularVerdict::quadrilateral) -> its
+  /// quadrilateral's ellipse; another solid mask (ObserveOptions::solid_min_solidity) -> its
+  /// hull fit; otherwise the box-inscribed ellipse
+  Solid,
 };
 
 /// Name <-> policy: "solid", "paper", "bbox", "mask", "given".
@@ -38,10 +42,11 @@ enum class MaskFitMethod {
 
 struct ObserveOptions {
   ObservationPolicy policy = ObservationPolicy::Solid;
-  MaskFitMethod regular_fit = MaskFitMethod::Quadrilateral;  ///< for regular masks
-  MaskFitMethod irregular_fit = MaskFitMethod::Hull;         ///< for other masks (policies Mask and Solid)
+  /// For regular masks (Paper), for masks that pass the quadrilateral test (Mask and Solid).
+  MaskFitMethod regular_fit = MaskFitMethod::Quadrilateral;
+  MaskFitMethod irregular_fit = MaskFitMethod::Hull;  ///< for other masks (policies Mask and Solid)
   RegularMaskOptions regular;
-  /// Policy Solid: a non-regular mask that covers at least this share of its convex hull
+  /// Policy Solid: any other mask that covers at least this share of its convex hull
   /// (RegularVerdict::solidity) gets its hull fit. The silhouette of a convex solid fills its
   /// hull; that of a composite object seen whole (a chair, a plant: about half to four fifths)
   /// has a hull close to its cuboid's silhouette, and the hull fit estimates the image of the

@@ -1,10 +1,15 @@
 #pragma once
 /// \file regular_mask.hpp
 /// Is a mask's outline roughly a convex quadrilateral (a "regular" object in the paper: a
-/// monitor, a book, a keyboard seen as one face)? Convex hull of the pixels -> reduction to the
-/// four corners that keep the most area; then checks that the mask fills that quadrilateral
-/// (overall, and in its core away from the noisy boundary), that three corners do not do as
-/// well (a triangle), and that the corners are real corners.
+/// monitor, a book, a keyboard seen as one face)? Two tests, both needed:
+/// - the quadrilateral test: convex hull of the pixels -> reduction to the four corners that keep
+///   the most area; the mask must fill that quadrilateral (overall, and in its core away from
+///   the noisy boundary), three corners must not do as well (a triangle), and the corners must
+///   be real corners. It tells whether the quadrilateral describes the mask, and so whether the
+///   quadrilateral's ellipse suits it (a box seen with a sliver of a second face passes);
+/// - the outline test, the paper's definition: the mask's outline reduced by Douglas-Peucker to
+///   within 2% of its length is a convex quadrilateral (one face of a box, not two or three;
+///   the simulator's truth applies it to the noise-free mask).
 
 #include <Eigen/Core>
 #include <array>
@@ -26,10 +31,16 @@ struct RegularMaskOptions {
   double max_corner_angle_deg = 160.0;  ///< a corner flatter than this is no corner
   double min_corner_angle_deg = 20.0;
   int min_pixels = 30;  ///< smaller masks are never regular: too few pixels to tell
+  /// Douglas-Peucker tolerance of the outline test, a share of the outline's length.
+  double outline_tolerance = 0.02;
 };
 
 struct RegularVerdict {
-  bool regular = false;
+  bool regular = false;        ///< both tests pass: the paper's regular object
+  bool quadrilateral = false;  ///< the quadrilateral test passes: its ellipse describes the mask
+  /// Vertices of the outer outline reduced by Douglas-Peucker (outline test; 4 and convex to
+  /// pass); 0 when the quadrilateral test failed, which spares the outline.
+  int outline_vertices = 0;
   int hull_vertices = 0;       ///< vertices of the convex hull of the mask's pixel squares
   int quad_vertices = 0;       ///< vertices of the reduced hull: 4, or fewer for a tiny hull
   double solidity = 0.0;       ///< mask area / hull area
@@ -45,10 +56,17 @@ struct RegularVerdict {
   std::vector<Eigen::Vector2d> hull;
 };
 
-/// Tests a run-length mask without decoding it: the convex hull of the pixel squares comes from
-/// each column's extreme rows, O(runs + columns). An empty or inconsistent mask is not
-/// regular (all diagnostics 0).
+/// Tests a run-length mask without decoding it: the convex hull of the pixel squares and the
+/// outline come from each column's extreme rows, O(runs + columns); the outline test runs when
+/// the quadrilateral test passes. An empty or inconsistent mask is not regular
+/// (all diagnostics 0).
 RegularVerdict testRegularMask(const RleMask& mask, const RegularMaskOptions& options = {});
+
+/// The outline test: the outline of the mask with every column filled between its extreme rows
+/// (through pixel centres, from the runs), reduced by Douglas-Peucker to within `tolerance` x
+/// its length; returns its vertex count and sets `*convex` to whether that polygon is convex.
+/// 0 for an empty or inconsistent mask. 4 and convex: the paper's regular object.
+int outlineVertices(const RleMask& mask, double tolerance = 0.02, bool* convex = nullptr);
 
 /// The rows a mask covers in one image column.
 struct MaskColumn {
