@@ -64,6 +64,17 @@ def test_regular_and_irregular_masks():
     rect = rectangle()
     verdict = E.test_regular_mask(rect)
     assert verdict.regular and bool(verdict) and verdict.quad_vertices == 4
+    assert verdict.quadrilateral and verdict.outline_vertices == 4
+    # A tilted rectangle: regular, but with no outline tolerance each pixel step is a vertex, and
+    # the outline test alone turns it down.
+    yy, xx = np.mgrid[0:120, 0:160]
+    u, v = (xx - 80) * np.cos(0.3) + (yy - 60) * np.sin(0.3), (yy - 60) * np.cos(0.3) - (xx - 80) * np.sin(0.3)
+    tilted = (abs(u) < 45) & (abs(v) < 25)
+    strict = E.RegularMaskOptions()
+    strict.outline_tolerance = 0.0
+    assert E.test_regular_mask(tilted).regular
+    turned_down = E.test_regular_mask(tilted, strict)
+    assert turned_down.quadrilateral and not turned_down.regular and turned_down.outline_vertices > 4
     np.testing.assert_allclose(np.sort(verdict.corners[:, 0]), [39.5, 39.5, 109.5, 109.5], atol=1e-9)  # pixel edges
     assert not E.test_regular_mask(disc()).regular
     # A regular rectangle's observation under the paper's policy is the ellipse inscribed in it.
