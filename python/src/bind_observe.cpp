@@ -61,7 +61,8 @@ void bindOptions(py::module_& m) {
       .def_readwrite("border_px", &ObserveOptions::border_px)
       .def_readwrite(
           "solid_min_solidity", &ObserveOptions::solid_min_solidity,
-          "policy 'solid': a non-regular mask covering at least this share of its convex hull gets the hull fit")
+          "policy 'solid': a mask the quadrilateral test turns down gets the hull fit when it covers at least "
+          "this share of its convex hull")
       .def("validate", &ObserveOptions::validate, "'' when every threshold is in range, else the first that is not.");
 }
 

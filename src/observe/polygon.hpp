@@ -110,11 +110,11 @@ inline std::vector<Point> columnOutline(const std::vector<MaskColumn>& cols) {
   return ring;
 }
 
-/// Douglas-Peucker on a closed ring, as cv::approxPolyDP does for a closed curve: split the
-/// ring at two far-apart points (the farthest from the first point, and the farthest from that
-/// one), then keep, recursively, the point of each chain farthest from the line through its
-/// ends while that distance exceeds `epsilon`, and finally drop the kept points that lie close to
-/// the line through their neighbours. Returns the kept points in ring order.
+/// Douglas-Peucker on a closed ring, in the manner of cv::approxPolyDP for a closed curve:
+/// split the ring at two far-apart points (the farthest from the first point, and the farthest
+/// from that one), then keep, recursively, the point of each chain farthest from the line
+/// through its ends while that distance exceeds `epsilon`, and finally drop the kept points
+/// that lie close to the line through their neighbours. Returns the kept points in ring order.
 inline std::vector<Point> douglasPeuckerRing(const std::vector<Point>& ring, double epsilon) {
   const size_t n = ring.size();
   if (n < 3) return ring;

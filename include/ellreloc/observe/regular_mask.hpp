@@ -38,7 +38,7 @@ struct RegularMaskOptions {
 struct RegularVerdict {
   bool regular = false;        ///< both tests pass: the paper's regular object
   bool quadrilateral = false;  ///< the quadrilateral test passes: its ellipse describes the mask
-  /// Vertices of the outer outline reduced by Douglas-Peucker (outline test; 4 and convex to
+  /// Vertices of the column outline reduced by Douglas-Peucker (outline test; 4 and convex to
   /// pass); 0 when the quadrilateral test failed, which spares the outline.
   int outline_vertices = 0;
   int hull_vertices = 0;       ///< vertices of the convex hull of the mask's pixel squares
