@@ -1,7 +1,8 @@
 // Observations, voxel maps and relocalization scored on scene folders with ground truth
 // (scene_folder.hpp: the independent renderer's scenes and `ellreloc simulate`'s output), so
 // that every figure can be compared across simulators. Prints four markdown tables:
-//   1. the regular-mask verdict against the truth (a convex quadrilateral outline);
+//   1. the regular-mask verdict against the truth (a convex quadrilateral outline), and the
+//      quadrilateral test alone (which chooses the default policy's ellipse);
 //   2. observation ellipses against the true projected ellipse: median W2(e, truth) / sqrt(ab)
 //      of the truth, by true class, for the box-inscribed ellipse, the three mask policies,
 //      and the box-inscribed ellipse scaled by the one factor that suits the scene best;
@@ -21,6 +22,7 @@
 #include "ellreloc/core/evaluation.hpp"
 #include "ellreloc/mapping/mapper.hpp"
 #include "ellreloc/observe/observe.hpp"
+#include "ellreloc/observe/regular_mask.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "map_scoring.hpp"
 #include "scene_folder.hpp"
@@ -44,6 +46,7 @@ ObserveOptions withPolicy(ObservationPolicy policy) {
 
 struct ObservationScores {
   int scored = 0, truly_regular = 0, flagged = 0, flagged_right = 0, right = 0;
+  int quadrilateral = 0, quadrilateral_right = 0;   ///< the quadrilateral test alone: passed, and truly regular
   std::vector<double> w2[2][std::size(kPolicies)];  // [truly regular][policy of kPolicies]
   /// [truly regular][k]: the box-inscribed ellipse with its axes scaled by kBoxScales[k]
   std::vector<double> scaled_box_w2[2][std::size(kBoxScales)];
@@ -72,16 +75,20 @@ ObservationScores scoreObservations(const bench::SceneFolder& s) {
         sc.flagged += verdict;
         sc.flagged_right += verdict && regular;
         sc.right += verdict == regular;
+        const bool quadrilateral = testRegularMask(*d.mask).quadrilateral;
+        sc.quadrilateral += quadrilateral;
+        sc.quadrilateral_right += quadrilateral && regular;
       }
     }
   return sc;
 }
 
 void printVerdictRow(const std::string& scene, const ObservationScores& sc) {
-  std::printf("| %s | %d | %d | %.1f%% | %.2f | %.2f |\n", scene.c_str(), sc.scored, sc.truly_regular,
-              100.0 * sc.right / std::max(sc.scored, 1),
-              sc.flagged > 0 ? static_cast<double>(sc.flagged_right) / sc.flagged : 0.0,
-              sc.truly_regular > 0 ? static_cast<double>(sc.flagged_right) / sc.truly_regular : 0.0);
+  const auto ratio = [](int a, int b) { return b > 0 ? static_cast<double>(a) / b : 0.0; };
+  std::printf("| %s | %d | %d | %.1f%% | %.2f | %.2f | %.2f | %.2f |\n", scene.c_str(), sc.scored, sc.truly_regular,
+              100.0 * ratio(sc.right, sc.scored), ratio(sc.flagged_right, sc.flagged),
+              ratio(sc.flagged_right, sc.truly_regular), ratio(sc.quadrilateral_right, sc.quadrilateral),
+              ratio(sc.quadrilateral_right, sc.truly_regular));
 }
 
 void printEllipseRows(const std::string& scene, const ObservationScores& sc) {
@@ -197,7 +204,8 @@ int main(int argc, char** argv) {
   }
   std::printf("Regular-mask verdict (policy paper) against the truth, query detections of true objects:\n\n");
   std::printf(
-      "| scene | detections | truly regular | verdict right | precision | recall |\n|---|---|---|---|---|---|\n");
+      "| scene | detections | truly regular | verdict right | precision | recall | quadrilateral test alone: precision "
+      "| quadrilateral test alone: recall |\n|---|---|---|---|---|---|---|---|\n");
   std::vector<ObservationScores> observations;
   for (const auto& s : scenes) {
     observations.push_back(scoreObservations(s));
