@@ -236,8 +236,8 @@ TEST(RegularMask, RealLabelmeMasks) {
   // 1.06 / 1.01): four-sided silhouettes. Failed: the other people (core fill 0.73-0.94: arms
   // and legs leave the quadrilateral's core empty), the sofa (0.26 solidity) and the large bus
   // showing two faces (fill 1.15, core 0.93). None is the paper's regular object: the outlines
-  // of the five keep 6, 7, 5, 7 and 6 vertices within 2% of their length (a bottle's neck, a
-  // car's bonnet), and the set holds no box-like object.
+  // of the five keep 6, 7, 5, 7 and 6 vertices within 2% of their length (a bottle, a chair, a
+  // person, a bus and a car are not four-sided), and the set holds no box-like object.
   const std::vector<bool> expected = {false, false, true, false, false, false, true, true, false, false, true, true};
   const auto frames = io::readDetections(test::dataPath("labelme_masks/detections.json"));
   std::vector<bool> quadrilaterals;
