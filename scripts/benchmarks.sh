@@ -65,8 +65,10 @@ table scene_accuracy "$bin/scene_accuracy" "$data/independent_synth/office_s11" 
 python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt")
 if [ -d "$build/python/ellreloc" ] && [ -n "$python" ]; then
   table python_overhead env PYTHONPATH="$build/python" "$python" benchmarks/python_overhead.py
+  table regular_verdict env PYTHONPATH="$build/python" "$python" benchmarks/regular_verdict.py \
+    "$data/independent_synth/office_s11" "$out/scenes/sim_office_1" "$out/scenes/sim_office_2"
 else
-  echo "benchmarks: python_overhead skipped (no Python bindings in $build)" >&2
+  echo "benchmarks: python_overhead and regular_verdict skipped (no Python bindings in $build)" >&2
 fi
 
 scripts/doc_images.sh "$build"
