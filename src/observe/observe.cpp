@@ -134,13 +134,13 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   // with a sliver of a second face, which the outline test turns down but whose quadrilateral
   // still describes it better than its hull does), else the hull's.
   const bool paper = opt.policy == ObservationPolicy::Paper;
-  const bool quadrilateral = paper ? verdict.regular : verdict.quadrilateral;
+  const bool quadrilateral_fit = paper ? verdict.regular : verdict.quadrilateral;
   const bool solid = opt.policy == ObservationPolicy::Solid && verdict.solidity >= opt.solid_min_solidity;
-  if ((paper || opt.policy == ObservationPolicy::Solid) && !quadrilateral && !solid) {
+  if ((paper || opt.policy == ObservationPolicy::Solid) && !quadrilateral_fit && !solid) {
     r.observation = obs;
     return r;
   }
-  const MaskFitMethod method = quadrilateral ? opt.regular_fit : opt.irregular_fit;
+  const MaskFitMethod method = quadrilateral_fit ? opt.regular_fit : opt.irregular_fit;
   std::optional<Ellipse> fitted = fitMaskEllipse(*mask, method, &verdict);
   if (!fitted && method != MaskFitMethod::Moments) fitted = fitMaskEllipse(*mask, MaskFitMethod::Moments, &verdict);
   if (!fitted || !fitted->isValid()) {
