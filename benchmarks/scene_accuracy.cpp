@@ -12,7 +12,8 @@
 //      and without the acceptance test), ours with the paper policy's observations, with box
 //      observations and with the mask policy's (every mask fitted), the OA-SLAM preset, and the refiner's optimum at
 //      the true pose with the matches found there (where the observations and the map put the pose when the search is
-//      perfect) with the default and the mask policy.
+//      perfect) with the default and the mask policy; and ours with every detection of a true object observed as its
+//      true projected ellipse (what the map alone allows).
 // Run: build/benchmarks/scene_accuracy DIR [DIR...]
 #include <cstdio>
 #include <iterator>
@@ -147,14 +148,34 @@ std::optional<PoseError> refinerOptimumAtTruth(const ObjectRelocalizer& reloc, c
   return poseError(refinePose(reloc.intrinsics(), truth, matches, {}, reloc.options().refinement.refiner).pose, truth);
 }
 
+/// The query frame's observations under `policy`; with `true_ellipses`, each detection of a
+/// true object takes its true projected ellipse instead (false positives keep theirs).
+std::vector<Observation> observeFrame(const bench::SceneFolder& s, const DetectionFrame& f, ObservationPolicy policy,
+                                      bool true_ellipses) {
+  std::vector<Observation> out;
+  for (const Detection& d : f.detections) {
+    ObserveResult r = observeDetection(d, s.K.width, s.K.height, withPolicy(policy));
+    if (!r.observation) continue;
+    const Detection* truth = true_ellipses ? bench::truthOf(s.query_truth, f, d) : nullptr;
+    if (truth && truth->ellipse && truth->object_id && *truth->object_id >= 0) {
+      r.observation->ellipse = *truth->ellipse;
+      r.observation->source = EllipseSource::Given;
+      r.observation->regular.reset();
+    }
+    out.push_back(*r.observation);
+  }
+  return out;
+}
+
 void relocalizeRow(const bench::SceneFolder& s, const char* map_name, const ObjectMap& map, const char* method,
-                   const RelocalizerOptions& options, ObservationPolicy policy, bool from_truth) {
+                   const RelocalizerOptions& options, ObservationPolicy policy, bool from_truth,
+                   bool true_ellipses = false) {
   const ObjectRelocalizer reloc(map, s.K, options);
   std::vector<std::optional<PoseError>> errors;
   for (const DetectionFrame& f : s.query) {
     const Pose* truth = io::framePose(s.query_poses, f);
     if (!truth) continue;
-    const std::vector<Observation> obs = observeDetections(f.detections, s.K.width, s.K.height, withPolicy(policy));
+    const std::vector<Observation> obs = observeFrame(s, f, policy, true_ellipses);
     if (from_truth) {
       errors.push_back(refinerOptimumAtTruth(reloc, obs, *truth));
       continue;
@@ -184,6 +205,8 @@ void scoreRelocalization(const bench::SceneFolder& s, const ObjectMap& voxel_map
                   true);
     relocalizeRow(s, map_name, *map, "the refiner's optimum at the true pose, mask policy", every_pose,
                   ObservationPolicy::Mask, true);
+    relocalizeRow(s, map_name, *map, "ours, every pose, true ellipses", every_pose, ObservationPolicy::Solid, false,
+                  true);
   }
 }
 
