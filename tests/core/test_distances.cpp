@@ -2,6 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <limits>
+#include <random>
+#include <vector>
 
 #include "ellreloc/core/distances.hpp"
 #include "fixtures/random_geometry.hpp"
@@ -219,6 +221,54 @@ TEST(EllipseIoU, LowerBoundHoldsAndSettles) {
   EXPECT_GT(settled, reaching / 4);
   EXPECT_EQ(ellipseIoULowerBound(Ellipse({0, 0}, {1, 1}, 0), Ellipse({1.5, 0}, {1, 1}, 0)), 0.0);
   EXPECT_GT(ellipseIoULowerBound(Ellipse({0, 0}, {2, 1}, 0.3), Ellipse({0, 0}, {2, 1}, 0.3), 32), 0.98);
+}
+
+// ellipseIoU adds the sectors of consecutive polygon edges outside the disc with one atan2 per
+// run; the reference here builds the same polygon vertex by vertex and adds every edge's exact
+// triangle-disc area with std::atan2.
+TEST(EllipseIoU, SectorRunsAgreeWithTheEdgeByEdgeArea) {
+  const auto reference = [](const Ellipse& e1, const Ellipse& e2, int n) {
+    const auto [big, small] = detail::discAndPolygon(e1, e2, e1.area(), e2.area());
+    const Eigen::Matrix2d to_disc = detail::toUnitDisc(big);
+    const Eigen::Matrix2d shape =
+        detail::polygonConstants(n).k * to_disc * small.rotation() * small.axes().asDiagonal();
+    const Eigen::Vector2d offset = to_disc * (small.center() - big.center());
+    const auto vertex = [&](int i) {
+      return Eigen::Vector2d(offset + shape * Eigen::Vector2d(std::cos(2 * M_PI * i / n), std::sin(2 * M_PI * i / n)));
+    };
+    double area = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d p = vertex(i), q = vertex(i + 1), d = q - p;
+      const double A = d.squaredNorm(), B = p.dot(d), C = p.squaredNorm() - 1.0, disc = B * B - A * C;
+      std::vector<double> cuts = {0.0};
+      for (double t : {(-B - std::sqrt(std::max(disc, 0.0))) / A, (-B + std::sqrt(std::max(disc, 0.0))) / A})
+        if (disc > 0.0 && t > 0.0 && t < 1.0) cuts.push_back(t);
+      cuts.push_back(1.0);
+      for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+        const Eigen::Vector2d a = p + cuts[k] * d, b = p + cuts[k + 1] * d;
+        const double cross = a(0) * b(1) - a(1) * b(0);
+        area += (0.5 * (a + b)).squaredNorm() <= 1.0 ? 0.5 * cross : 0.5 * std::atan2(cross, a.dot(b));
+      }
+    }
+    const double inter = std::min(std::abs(area) * big.axes().prod(), small.area());
+    return inter / (e1.area() + e2.area() - inter);
+  };
+  std::mt19937 rng(138);
+  double worst = 0.0;
+  for (int i = 0; i < 5000; ++i) {
+    const Ellipse a = test::randomEllipse(rng);
+    // Any size and aspect, centred within a few semi-axes: long runs of edges outside the disc.
+    const Ellipse b(
+        a.center() + Eigen::Vector2d(test::uniform(rng, -2, 2), test::uniform(rng, -2, 2)) * a.axes().maxCoeff(),
+        a.axes().cwiseProduct(Eigen::Vector2d(test::uniform(rng, 0.05, 4), test::uniform(rng, 0.05, 4))),
+        test::uniform(rng, 0, M_PI));
+    if (ellipseIoU(a, b, 32) == 0.0) continue;  // disjoint boxes: no polygon
+    for (int n : {32, 128}) worst = std::max(worst, std::abs(ellipseIoU(a, b, n) - reference(a, b, n)));
+  }
+  EXPECT_LT(worst, 1e-7);
+  // A thin ellipse across a round one: two runs of edges outside, each far under pi.
+  const Ellipse round({0, 0}, {10, 10}, 0), thin({0, 0}, {30, 1}, 0.4);
+  EXPECT_NEAR(ellipseIoU(round, thin), reference(round, thin, 128), 1e-7);
 }
 
 TEST(EllipseIoU, FastAtan2IsWithin2e8OfStdAtan2) {

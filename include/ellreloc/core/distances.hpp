@@ -107,15 +107,16 @@ inline double bhattacharyya(const Ellipse& a, const Ellipse& b) {
 
 namespace detail {
 
-/// What ellipseIoU's polygon of n vertices needs: cos and sin of its angular step, and the
-/// radius factor k that gives it the ellipse's area, (n/2) sin(2 pi/n) k^2 = pi. Computed once
-/// for the vertex counts in use (32 and 128).
+/// What ellipseIoU's polygon of n vertices needs: cos and sin of its angular step, the radius
+/// factor k that gives it the ellipse's area, (n/2) sin(2 pi/n) k^2 = pi, and the length of its
+/// edges on the unit circle, 2 sin(pi/n). Computed once for the vertex counts in use (32 and 128).
 struct PolygonConstants {
-  double cs, sn, k;
+  double cs, sn, k, chord;
 };
 inline PolygonConstants makePolygonConstants(int vertices) {
   const double step = 2.0 * M_PI / vertices;
-  return {std::cos(step), std::sin(step), std::sqrt(M_PI / (0.5 * vertices * std::sin(step)))};
+  return {std::cos(step), std::sin(step), std::sqrt(M_PI / (0.5 * vertices * std::sin(step))),
+          2.0 * std::sin(0.5 * step)};
 }
 inline PolygonConstants polygonConstants(int vertices) {
   static const PolygonConstants c32 = makePolygonConstants(32), c128 = makePolygonConstants(128);
@@ -155,6 +156,19 @@ inline double fastAtan2(double y, double x) {
   if (ay > ax) a = 0.5 * M_PI - a;
   if (x < 0.0) a = M_PI - a;
   return y < 0.0 ? -a : a;
+}
+
+/// Whether the segment p-q stays outside the unit disc (touching it at most), so that
+/// triangleDiscArea(p, q) is the circular sector it subtends.
+inline bool segmentOutsideDisc(const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
+  const double C = p.squaredNorm() - 1.0;
+  if (!(C > 0.0) || !(q.squaredNorm() > 1.0)) return false;
+  const Eigen::Vector2d d = q - p;
+  const double A = d.squaredNorm(), B = p.dot(d), disc = B * B - A * C;
+  if (!(A > 0.0 && disc > 0.0)) return true;
+  const double r = std::sqrt(disc);
+  const double t1 = (-B - r) / A, t2 = (-B + r) / A;
+  return !(t1 > 0.0 && t1 < 1.0) && !(t2 > 0.0 && t2 < 1.0);
 }
 
 /// Signed area of (triangle origin, p, q) intersected with the unit disc.
@@ -214,12 +228,32 @@ inline double ellipseIoU(const Ellipse& e1, const Ellipse& e2, int vertices = 12
   const Eigen::Vector2d first = offset + shape * unit;
   Eigen::Vector2d prev = first;
   double inter_disc = 0.0;  // intersection area in the disc frame
+  // Edges that stay outside the disc add circular sectors whose angles add up: a run of them
+  // takes one atan2 of its ends instead of one per edge. An edge outside the unit disc
+  // subtends at most its length, and every edge is at most |shape|_F 2 sin(pi / n) long, so a
+  // run of max_run edges spans at most 3 radians: atan2 of its ends is its angle.
+  const double edge_bound = shape.norm() * polygon.chord;
+  const int max_run = edge_bound > 3.0 / vertices ? std::max(1, static_cast<int>(3.0 / edge_bound)) : vertices;
+  Eigen::Vector2d run_start = first;
+  int run = 0;
+  const auto closeRun = [&](const Eigen::Vector2d& end) {
+    inter_disc += 0.5 * detail::fastAtan2(run_start(0) * end(1) - run_start(1) * end(0), run_start.dot(end));
+    run = 0;
+  };
   for (int i = 1; i <= vertices; ++i) {
     unit = Eigen::Vector2d(cs * unit(0) - sn * unit(1), sn * unit(0) + cs * unit(1));
     const Eigen::Vector2d cur = i == vertices ? first : Eigen::Vector2d(offset + shape * unit);
-    inter_disc += detail::triangleDiscArea(prev, cur);
+    if (detail::segmentOutsideDisc(prev, cur)) {
+      if (run == max_run) closeRun(prev);
+      if (run == 0) run_start = prev;
+      ++run;
+    } else {
+      if (run > 0) closeRun(prev);
+      inter_disc += detail::triangleDiscArea(prev, cur);
+    }
     prev = cur;
   }
+  if (run > 0) closeRun(prev);
   // Both maps have a positive determinant, so the polygon stays counter-clockwise.
   const double inter = std::min(std::abs(inter_disc) * big.axes().prod(), small.area());
   const double uni = e1.area() + e2.area() - inter;
