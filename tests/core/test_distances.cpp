@@ -71,6 +71,15 @@ Ellipse nearby(std::mt19937& rng, const Ellipse& e) {
                  {uniform(rng, 5, 120), uniform(rng, 5, 120)}, uniform(rng, -M_PI, M_PI));
 }
 
+/// An ellipse centred within `spread` of e's largest semi-axis from e's centre, each semi-axis
+/// e's times a factor in [lo, hi], at any angle.
+Ellipse anyNear(std::mt19937& rng, const Ellipse& e, double spread, double lo, double hi) {
+  return Ellipse(e.center() + Eigen::Vector2d(uniform(rng, -spread, spread), uniform(rng, -spread, spread)) *
+                                  e.axes().maxCoeff(),
+                 e.axes().cwiseProduct(Eigen::Vector2d(uniform(rng, lo, hi), uniform(rng, lo, hi))),
+                 uniform(rng, 0, M_PI));
+}
+
 }  // namespace
 
 TEST(Wasserstein, AgreesWithMatrixSquareRootEvaluation) {
@@ -184,11 +193,7 @@ TEST(EllipseIoU, UpperBoundHoldsAndPrunes) {
   int pruned = 0, pairs = 0;
   for (int i = 0; i < 20000; ++i) {
     const Ellipse a = test::randomEllipse(rng);
-    // Near pairs: the second centred within a few semi-axes of the first, of any size.
-    const Ellipse b(
-        a.center() + Eigen::Vector2d(test::uniform(rng, -3, 3), test::uniform(rng, -3, 3)) * a.axes().maxCoeff(),
-        a.axes().cwiseProduct(Eigen::Vector2d(test::uniform(rng, 0.1, 3), test::uniform(rng, 0.1, 3))),
-        test::uniform(rng, 0, M_PI));
+    const Ellipse b = anyNear(rng, a, 3, 0.1, 3);  // centred within a few semi-axes, of any size
     for (int vertices : {32, 128}) {
       const double iou = ellipseIoU(a, b, vertices), bound = ellipseIoUUpperBound(a, b, vertices);
       ASSERT_GE(bound, iou - 1e-12) << i << " " << vertices;
@@ -257,11 +262,7 @@ TEST(EllipseIoU, SectorRunsAgreeWithTheEdgeByEdgeArea) {
   double worst = 0.0;
   for (int i = 0; i < 5000; ++i) {
     const Ellipse a = test::randomEllipse(rng);
-    // Any size and aspect, centred within a few semi-axes: long runs of edges outside the disc.
-    const Ellipse b(
-        a.center() + Eigen::Vector2d(test::uniform(rng, -2, 2), test::uniform(rng, -2, 2)) * a.axes().maxCoeff(),
-        a.axes().cwiseProduct(Eigen::Vector2d(test::uniform(rng, 0.05, 4), test::uniform(rng, 0.05, 4))),
-        test::uniform(rng, 0, M_PI));
+    const Ellipse b = anyNear(rng, a, 2, 0.05, 4);  // thin ones too: long runs of edges outside the disc
     if (ellipseIoU(a, b, 32) == 0.0) continue;  // disjoint boxes: no polygon
     for (int n : {32, 128}) worst = std::max(worst, std::abs(ellipseIoU(a, b, n) - reference(a, b, n)));
   }
