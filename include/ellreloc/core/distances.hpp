@@ -163,12 +163,11 @@ inline double fastAtan2(double y, double x) {
 inline bool segmentOutsideDisc(const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
   const double C = p.squaredNorm() - 1.0;
   if (!(C > 0.0) || !(q.squaredNorm() > 1.0)) return false;
+  // Both ends are outside: |p + t d|^2 = 1 has its roots on one side of [0, 1], and the segment
+  // enters the disc only when its point nearest the centre, t = -B / A, lies within and inside.
   const Eigen::Vector2d d = q - p;
-  const double A = d.squaredNorm(), B = p.dot(d), disc = B * B - A * C;
-  if (!(A > 0.0 && disc > 0.0)) return true;
-  const double r = std::sqrt(disc);
-  const double t1 = (-B - r) / A, t2 = (-B + r) / A;
-  return !(t1 > 0.0 && t1 < 1.0) && !(t2 > 0.0 && t2 < 1.0);
+  const double A = d.squaredNorm(), B = p.dot(d);
+  return !(B < 0.0 && -B < A && B * B - A * C > 0.0);
 }
 
 /// Signed area of (triangle origin, p, q) intersected with the unit disc.
