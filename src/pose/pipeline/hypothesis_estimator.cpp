@@ -76,10 +76,12 @@ int HypothesisEstimator::generate(const int* s, Model* models) const {
 /// The centre of a projected ellipsoid's image is not the image of its centre: remove that
 /// offset (measured at the current pose) from the observed centres and solve P3P again.
 bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
+  if (!K_.isValid() || !pose->isValid()) return false;
+  const Eigen::Matrix<double, 3, 4> P = projectionMatrix(K_, *pose);
   std::array<Eigen::Vector3d, 3> bearings, centres;
   for (int k = 0; k < 3; ++k) {
     const Ellipsoid& e = map_.objects[pairs_[s[k]].object].ellipsoid;
-    const std::optional<Eigen::Vector2d> image_centre = scorer_.projectedCentre(pairs_[s[k]].object, *pose);
+    const std::optional<Eigen::Vector2d> image_centre = scorer_.projectedCentre(pairs_[s[k]].object, P, *pose);
     if (!image_centre) return false;
     const Eigen::Vector2d offset = *image_centre - K_.project(pose->transform(e.center()));
     bearings[k] = K_.bearing(observations_[pairs_[s[k]].observation].ellipse.center() - offset);

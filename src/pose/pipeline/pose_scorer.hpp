@@ -59,10 +59,10 @@ class PoseScorer {
     return projectPrepared(prepared_[static_cast<size_t>(j)], projectionMatrix(K_, pose), pose);
   }
 
-  /// The centre of projectObject(j, pose)'s ellipse, computed alone (projectedCentre).
-  std::optional<Eigen::Vector2d> projectedCentre(int j, const Pose& pose) const {
-    if (!K_.isValid() || !pose.isValid()) return std::nullopt;
-    return ellreloc::projectedCentre(prepared_[static_cast<size_t>(j)], projectionMatrix(K_, pose), pose);
+  /// The centre of projectObject(j, pose)'s ellipse, computed alone (projectedCentre); P is
+  /// projectionMatrix(K, pose) of a valid pose, computed once for the objects of a pose.
+  std::optional<Eigen::Vector2d> projectedCentre(int j, const Eigen::Matrix<double, 3, 4>& P, const Pose& pose) const {
+    return ellreloc::projectedCentre(prepared_[static_cast<size_t>(j)], P, pose);
   }
 
   const ScoringOptions& options() const { return options_; }
