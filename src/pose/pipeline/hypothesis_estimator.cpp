@@ -23,13 +23,15 @@ EllipseMatch ellipseMatchOf(const CandidatePair& pair, const std::vector<Observa
 bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int count, bool check_overlap,
                                  KnownProjections* own) const {
   if (!gate_.admits(pose)) return false;
-  const double min_overlap = options_.scoring.min_overlap;
   own->count = 0;
+  if (!K_.isValid() || !pose.isValid()) return false;
+  const Eigen::Matrix<double, 3, 4> P = projectionMatrix(K_, pose);
+  const double min_overlap = options_.scoring.min_overlap;
   // Three in five P3P poses fail here, nearly all on an overlap bound: every own pair's bound
   // is checked as soon as it is projected, before any exact overlap.
   for (int k = 0; k < count; ++k) {
     const CandidatePair& c = pairs_[static_cast<size_t>(pair_indices[k])];
-    const Projection p = scorer_.projectObject(c.object, pose);
+    const Projection p = scorer_.projectObject(c.object, P, pose);
     if (!p.ok()) return false;
     if (check_overlap &&
         !scorer_.overlapMayReach(observations_[c.observation], p.ellipse, kRankingIoUVertices, min_overlap))

@@ -53,14 +53,13 @@ class PoseScorer {
               const KnownProjections* known = nullptr, double give_up_at = std::numeric_limits<double>::infinity());
 
   /// project(map object j, K, pose), with the object's quantities computed once; j must be a
-  /// candidate of some observation.
-  Projection projectObject(int j, const Pose& pose) const {
-    if (!K_.isValid() || !pose.isValid()) return Projection{};
-    return projectPrepared(prepared_[static_cast<size_t>(j)], projectionMatrix(K_, pose), pose);
+  /// candidate of some observation, P projectionMatrix(K, pose) of a valid pose (computed once
+  /// for the objects of a pose).
+  Projection projectObject(int j, const Eigen::Matrix<double, 3, 4>& P, const Pose& pose) const {
+    return projectPrepared(prepared_[static_cast<size_t>(j)], P, pose);
   }
 
-  /// The centre of projectObject(j, pose)'s ellipse, computed alone (projectedCentre); P is
-  /// projectionMatrix(K, pose) of a valid pose, computed once for the objects of a pose.
+  /// The centre of projectObject(j, P, pose)'s ellipse, computed alone (projectedCentre).
   std::optional<Eigen::Vector2d> projectedCentre(int j, const Eigen::Matrix<double, 3, 4>& P, const Pose& pose) const {
     return ellreloc::projectedCentre(prepared_[static_cast<size_t>(j)], P, pose);
   }
