@@ -24,14 +24,14 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
                                  KnownProjections* own) const {
   if (!gate_.admits(pose)) return false;
   own->count = 0;
-  if (!K_.isValid() || !pose.isValid()) return false;
-  const Eigen::Matrix<double, 3, 4> P = projectionMatrix(K_, pose);
+  const std::optional<Eigen::Matrix<double, 3, 4>> P = scorer_.projectionAt(pose);
+  if (!P) return false;
   const double min_overlap = options_.scoring.min_overlap;
   // Three in five P3P poses fail here, nearly all on an overlap bound: every own pair's bound
   // is checked as soon as it is projected, before any exact overlap.
   for (int k = 0; k < count; ++k) {
     const CandidatePair& c = pairs_[static_cast<size_t>(pair_indices[k])];
-    const Projection p = scorer_.projectObject(c.object, P, pose);
+    const Projection p = scorer_.projectObject(c.object, *P, pose);
     if (!p.ok()) return false;
     if (check_overlap &&
         !scorer_.overlapMayReach(observations_[c.observation], p.ellipse, kRankingIoUVertices, min_overlap))
@@ -78,12 +78,12 @@ int HypothesisEstimator::generate(const int* s, Model* models) const {
 /// The centre of a projected ellipsoid's image is not the image of its centre: remove that
 /// offset (measured at the current pose) from the observed centres and solve P3P again.
 bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
-  if (!K_.isValid() || !pose->isValid()) return false;
-  const Eigen::Matrix<double, 3, 4> P = projectionMatrix(K_, *pose);
+  const std::optional<Eigen::Matrix<double, 3, 4>> P = scorer_.projectionAt(*pose);
+  if (!P) return false;
   std::array<Eigen::Vector3d, 3> bearings, centres;
   for (int k = 0; k < 3; ++k) {
     const Ellipsoid& e = map_.objects[pairs_[s[k]].object].ellipsoid;
-    const std::optional<Eigen::Vector2d> image_centre = scorer_.projectedCentre(pairs_[s[k]].object, P, *pose);
+    const std::optional<Eigen::Vector2d> image_centre = scorer_.projectedCentre(pairs_[s[k]].object, *P, *pose);
     if (!image_centre) return false;
     const Eigen::Vector2d offset = *image_centre - K_.project(pose->transform(e.center()));
     bearings[k] = K_.bearing(observations_[pairs_[s[k]].observation].ellipse.center() - offset);

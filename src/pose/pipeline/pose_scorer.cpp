@@ -118,8 +118,7 @@ double PoseScorer::costLowerBound(int vertices) {
 
 double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches,
                         const KnownProjections* known, double give_up_at) {
-  const bool valid = K_.isValid() && pose.isValid();  // checked once, not per object
-  const Eigen::Matrix<double, 3, 4> P = valid ? projectionMatrix(K_, pose) : Eigen::Matrix<double, 3, 4>::Zero();
+  const std::optional<Eigen::Matrix<double, 3, 4>> P = projectionAt(pose);  // checked once, not per object
   for (int j : relevant_) {
     const int* k = known ? std::find(known->objects, known->objects + known->count, j) : nullptr;
     if (known && k != known->objects + known->count) {
@@ -130,13 +129,13 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     }
     // Most objects are out of view at most poses: a cheap test spares their projection.
     const ProjectableEllipsoid& e = prepared_[static_cast<size_t>(j)];
-    if (valid && e.valid &&
+    if (P && e.valid &&
         certainlyOutside(e.ellipsoid.center(), e.ellipsoid.axes().maxCoeff(), pose, K_,
                          candidate_area_[static_cast<size_t>(j)])) {
       projects_[j] = 0;
       continue;
     }
-    const Projection p = valid ? projectPrepared(e, P, pose) : Projection{};
+    const Projection p = P ? projectPrepared(e, *P, pose) : Projection{};
     projects_[j] = p.ok();
     if (p.ok()) {
       projected_[j] = p.ellipse;

@@ -52,9 +52,15 @@ class PoseScorer {
   double cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches = nullptr,
               const KnownProjections* known = nullptr, double give_up_at = std::numeric_limits<double>::infinity());
 
+  /// projectionMatrix(K, pose), or nullopt for invalid intrinsics or pose (nothing projects):
+  /// computed once for the objects of a pose.
+  std::optional<Eigen::Matrix<double, 3, 4>> projectionAt(const Pose& pose) const {
+    if (!K_.isValid() || !pose.isValid()) return std::nullopt;
+    return projectionMatrix(K_, pose);
+  }
+
   /// project(map object j, K, pose), with the object's quantities computed once; j must be a
-  /// candidate of some observation, P projectionMatrix(K, pose) of a valid pose (computed once
-  /// for the objects of a pose).
+  /// candidate of some observation, P = *projectionAt(pose).
   Projection projectObject(int j, const Eigen::Matrix<double, 3, 4>& P, const Pose& pose) const {
     return projectPrepared(prepared_[static_cast<size_t>(j)], P, pose);
   }
