@@ -109,20 +109,30 @@ TEST(Projection, FailuresAreStatusesNotNaN) {
   EXPECT_EQ(project(Ellipsoid({0, 0, 3}, {0.2, 0.3, 0.4}, I), Intrinsics(0, 500, 320, 240, 640, 480), identity).status,
             ProjectionStatus::InvalidInput);
 
-  // Random placements around the camera: every result is either a valid ellipse or a status.
+  // Random placements around a camera in random poses: every result is either a valid ellipse
+  // or a status, and an ellipse exactly when the support function puts the whole ellipsoid in
+  // front of the camera (the projection tests it by the sign of C*_33 instead).
   std::mt19937 rng(23);
   int ok = 0, failed = 0;
   for (int i = 0; i < 2000; ++i) {
     const Ellipsoid e({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
                       {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
                       ellreloc::test::randomRotation(rng));
-    const Projection p = project(e, K, identity);
+    const Eigen::Vector3d t(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Pose pose(ellreloc::test::randomRotation(rng), t);
+    const Projection p = project(e, K, pose);
+    double near = 0.0, far = 0.0;
+    depthRange<double>(pose.rotation(), pose.translation(), e.center(), e.shapeMatrix(), &near, &far);
+    EXPECT_EQ(p.ok(), near > 0.0) << toString(p.status) << ", nearest depth " << near;
     if (p.ok()) {
       EXPECT_TRUE(p.ellipse.isValid());
       // In front of the camera: every surface point has positive depth.
-      for (const auto& x : e.sampleSurface(50)) EXPECT_GT(x(2), 0.0);
+      for (const auto& x : e.sampleSurface(50)) EXPECT_GT(pose.transform(x)(2), 0.0);
       ++ok;
     } else {
+      EXPECT_EQ(p.status, e.contains(pose.center()) ? ProjectionStatus::ContainsCamera
+                          : far <= 0.0             ? ProjectionStatus::BehindCamera
+                                                   : ProjectionStatus::NotAnEllipse);
       ++failed;
     }
   }
@@ -142,7 +152,7 @@ TEST(Projection, CentreAloneIsTheCentreOfTheWholeProjection) {
                       ellreloc::test::randomRotation(rng));
     const Projection whole = project(e, K, identity);
     const std::optional<Eigen::Vector2d> centre =
-        projectedCentre(ProjectableEllipsoid(e), projectionMatrix(K, identity), identity);
+        projectedCentre(ProjectableEllipsoid(e), projectionMatrix(K, identity));
     ASSERT_EQ(centre.has_value(), whole.ok()) << toString(whole.status);
     if (!whole.ok()) {
       ++failed;

@@ -83,24 +83,42 @@ struct ProjectableEllipsoid {
   }
 };
 
+namespace detail {
+
+/// Q* p3 for the last row p3 of P: the last column of C* = P Q* P^T is P (Q* p3), and its last
+/// entry p3^T Q* p3 = r3^T M r3 - z_c^2 (Q* scaled to Q*_33 = -1, r3 and z_c the optical axis
+/// and the centre's depth) is negative exactly when the principal plane misses the ellipsoid.
+inline Eigen::Vector4d dualQuadricTimesLastRow(const ProjectableEllipsoid& e, const Eigen::Matrix<double, 3, 4>& P) {
+  return e.dual_quadric * P.row(2).transpose();
+}
+
+/// Whether the image is an ellipse (the ellipsoid strictly in front of the principal plane):
+/// the centre in front and the principal plane missing the ellipsoid. A camera inside the
+/// ellipsoid fails it too, since every plane through the camera cuts the ellipsoid.
+inline bool inFrontOfPrincipalPlane(const ProjectableEllipsoid& e, const Eigen::Matrix<double, 3, 4>& P,
+                                    const Eigen::Vector4d& q3) {
+  const double zc = P.row(2).head<3>().dot(e.ellipsoid.center()) + P(2, 3);
+  return zc > 0.0 && P.row(2).dot(q3) < 0.0;
+}
+
+/// Why an ellipsoid has no elliptic image at a pose (inFrontOfPrincipalPlane failed).
+inline ProjectionStatus whyNoEllipse(const ProjectableEllipsoid& e, const Pose& pose) {
+  if (e.ellipsoid.contains(pose.center())) return ProjectionStatus::ContainsCamera;
+  double near = 0.0, far = 0.0;
+  depthRange<double>(pose.rotation(), pose.translation(), e.ellipsoid.center(), e.shape, &near, &far);
+  return far <= 0.0 ? ProjectionStatus::BehindCamera : ProjectionStatus::NotAnEllipse;
+}
+
+}  // namespace detail
+
 /// project() for a prepared ellipsoid and the camera matrix P = projectionMatrix(K, pose) of a
-/// valid pose: the same result, bit for bit, without recomputing what does not change.
+/// valid pose: the same result without recomputing what does not change.
 inline Projection projectPrepared(const ProjectableEllipsoid& e, const Eigen::Matrix<double, 3, 4>& P,
                                   const Pose& pose) {
   Projection out;
   if (!e.valid) return out;
-  if (e.ellipsoid.contains(pose.center())) {
-    out.status = ProjectionStatus::ContainsCamera;
-    return out;
-  }
-  double near = 0.0, far = 0.0;
-  depthRange<double>(pose.rotation(), pose.translation(), e.ellipsoid.center(), e.shape, &near, &far);
-  if (far <= 0.0) {
-    out.status = ProjectionStatus::BehindCamera;
-    return out;
-  }
-  if (near <= 0.0) {
-    out.status = ProjectionStatus::NotAnEllipse;
+  if (!detail::inFrontOfPrincipalPlane(e, P, detail::dualQuadricTimesLastRow(e, P))) {
+    out.status = detail::whyNoEllipse(e, pose);
     return out;
   }
   const std::optional<Ellipse> ellipse = Ellipse::fromDualConic(projectDualQuadric<double>(P, e.dual_quadric));
@@ -117,12 +135,11 @@ inline Projection projectPrepared(const ProjectableEllipsoid& e, const Eigen::Ma
 /// elliptic image: C*(0:2, 2) / C*(2, 2), the last column of C* = P Q* P^T being P Q* p3 (p3 =
 /// the last row of P). A fraction of the whole projection's cost.
 inline std::optional<Eigen::Vector2d> projectedCentre(const ProjectableEllipsoid& e,
-                                                      const Eigen::Matrix<double, 3, 4>& P, const Pose& pose) {
-  if (!e.valid || e.ellipsoid.contains(pose.center())) return std::nullopt;
-  double near = 0.0, far = 0.0;
-  depthRange<double>(pose.rotation(), pose.translation(), e.ellipsoid.center(), e.shape, &near, &far);
-  if (!(near > 0.0)) return std::nullopt;
-  const Eigen::Vector3d last = P * (e.dual_quadric * P.row(2).transpose());
+                                                      const Eigen::Matrix<double, 3, 4>& P) {
+  if (!e.valid) return std::nullopt;
+  const Eigen::Vector4d q3 = detail::dualQuadricTimesLastRow(e, P);
+  if (!detail::inFrontOfPrincipalPlane(e, P, q3)) return std::nullopt;
+  const Eigen::Vector3d last = P * q3;
   if (!last.allFinite() || !(std::abs(last(2)) > 0.0)) return std::nullopt;
   return Eigen::Vector2d(last(0) / last(2), last(1) / last(2));
 }

@@ -83,7 +83,7 @@ bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
   std::array<Eigen::Vector3d, 3> bearings, centres;
   for (int k = 0; k < 3; ++k) {
     const Ellipsoid& e = map_.objects[pairs_[s[k]].object].ellipsoid;
-    const std::optional<Eigen::Vector2d> image_centre = scorer_.projectedCentre(pairs_[s[k]].object, *P, *pose);
+    const std::optional<Eigen::Vector2d> image_centre = scorer_.projectedCentre(pairs_[s[k]].object, *P);
     if (!image_centre) return false;
     const Eigen::Vector2d offset = *image_centre - K_.project(pose->transform(e.center()));
     bearings[k] = K_.bearing(observations_[pairs_[s[k]].observation].ellipse.center() - offset);

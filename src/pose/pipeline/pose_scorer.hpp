@@ -66,8 +66,8 @@ class PoseScorer {
   }
 
   /// The centre of projectObject(j, P, pose)'s ellipse, computed alone (projectedCentre).
-  std::optional<Eigen::Vector2d> projectedCentre(int j, const Eigen::Matrix<double, 3, 4>& P, const Pose& pose) const {
-    return ellreloc::projectedCentre(prepared_[static_cast<size_t>(j)], P, pose);
+  std::optional<Eigen::Vector2d> projectedCentre(int j, const Eigen::Matrix<double, 3, 4>& P) const {
+    return ellreloc::projectedCentre(prepared_[static_cast<size_t>(j)], P);
   }
 
   const ScoringOptions& options() const { return options_; }
