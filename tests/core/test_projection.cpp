@@ -140,6 +140,57 @@ TEST(Projection, FailuresAreStatusesNotNaN) {
   EXPECT_GT(failed, 100);
 }
 
+TEST(Projection, ImageAreaBoundsHoldAtRandomPoses) {
+  const Intrinsics K = ellreloc::test::testIntrinsics();
+  std::mt19937 rng(25);
+  int ok = 0, failed = 0, lower_useful = 0, upper_useful = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Ellipsoid e({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
+                      {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
+                      ellreloc::test::randomRotation(rng));
+    const Pose pose(ellreloc::test::randomRotation(rng), {uniform(rng, -1, 1), uniform(rng, -1, 1), 0.0});
+    const Projection p = project(e, K, pose);
+    const ImageAreaBounds b = imageAreaBounds(ProjectableEllipsoid(e), K, pose);
+    if (!p.ok()) {
+      ++failed;
+      continue;
+    }
+    ++ok;
+    const double area = p.ellipse.area();
+    EXPECT_LE(b.lower, area * (1 + 1e-9)) << "placement " << i;
+    EXPECT_GE(b.upper, area * (1 - 1e-9)) << "placement " << i;
+    lower_useful += b.lower > 0.25 * area;
+    upper_useful += b.upper < 4.0 * area;
+  }
+  EXPECT_GT(ok, 500);
+  EXPECT_GT(failed, 500);
+  // Not vacuous: for many placements (random axes 0.01-1 m, often needles or discs) each bound
+  // is within a factor 4 of the area.
+  EXPECT_GT(lower_useful, ok / 3);
+  EXPECT_GT(upper_useful, ok / 3);
+}
+
+TEST(Projection, ImageAreaBoundsAreExactForSpheresAndCloseForDiscsFacingTheCamera) {
+  const Intrinsics K = ellreloc::test::testIntrinsics();
+  const Pose identity;
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  for (const Eigen::Vector3d c : {Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(1.5, -1, 2.5), Eigen::Vector3d(-2, 0, 2)}) {
+    const Ellipsoid sphere(c, {0.3, 0.3, 0.3}, I);
+    const double area = project(sphere, K, identity).ellipse.area();
+    const ImageAreaBounds b = imageAreaBounds(ProjectableEllipsoid(sphere), K, identity);
+    EXPECT_NEAR(b.lower, area, 1e-9 * area);
+    EXPECT_NEAR(b.upper, area, 1e-9 * area);
+  }
+  // A disc 2 mm thick facing the camera: the sphere of its smallest axis says nothing, its
+  // section nearly everything (within (D / sqrt(D^2 + r^2))^3 = 0.985 of the area).
+  const Ellipsoid disc({0, 0, 3}, {0.3, 0.2, 0.002}, I);
+  const double area = project(disc, K, identity).ellipse.area();
+  EXPECT_GT(imageAreaBounds(ProjectableEllipsoid(disc), K, identity).lower, 0.98 * area);
+  // Where no image is an ellipse, the lower bound is infinite.
+  EXPECT_EQ(imageAreaBounds(ProjectableEllipsoid(Ellipsoid({0, 0, 0.1}, {0.2, 0.2, 0.2}, I)), K, identity).lower,
+            INFINITY);
+}
+
 TEST(Projection, CentreAloneIsTheCentreOfTheWholeProjection) {
   // Random placements around the camera, in front, behind, around and across it.
   const Intrinsics K = ellreloc::test::testIntrinsics();

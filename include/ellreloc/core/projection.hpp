@@ -4,6 +4,7 @@
 /// the paper's eq. 7).
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -73,6 +74,7 @@ struct ProjectableEllipsoid {
   Ellipsoid ellipsoid;
   Eigen::Matrix4d dual_quadric = Eigen::Matrix4d::Zero();
   Eigen::Matrix3d shape = Eigen::Matrix3d::Zero();
+  double smallest_axis = 0.0, largest_axis = 0.0, axes_product = 0.0;
   bool valid = false;
 
   ProjectableEllipsoid() = default;
@@ -80,8 +82,51 @@ struct ProjectableEllipsoid {
     if (!valid) return;
     dual_quadric = e.dualQuadric();
     shape = e.shapeMatrix();
+    smallest_axis = e.axes().minCoeff();
+    largest_axis = e.axes().maxCoeff();
+    axes_product = e.axes().prod();
   }
 };
+
+/// Bounds on the area of an ellipsoid's image, in square pixels, without projecting it.
+struct ImageAreaBounds {
+  double lower = 0.0;
+  double upper = INFINITY;
+};
+
+/// Whenever an ellipsoid's image at a valid pose is an ellipse, its area lies within these
+/// bounds; where it cannot be one (the sphere of the smallest semi-axis reaches the principal
+/// plane), `lower` is infinite. The image contains the images of the sphere of the smallest
+/// semi-axis and of the central section facing the camera, and lies within the image of the
+/// sphere of the largest semi-axis:
+///  - a sphere of radius r, centre at distance D and depth z > r, images to an ellipse of
+///    normalised area pi r^2 sqrt(D^2 - r^2) / (z^2 - r^2)^(3/2) (a cone's section);
+///  - the central section normal to the line of sight u has area pi a b c / sqrt(u^T M u), and
+///    each of its points lies within the largest semi-axis of the centre, so its solid angle is
+///    at least that area times D / (D^2 + a_max^2)^(3/2); a normalised image is at least as
+///    large as its solid angle.
+/// Pixels scale normalised areas by fx fy.
+inline ImageAreaBounds imageAreaBounds(const ProjectableEllipsoid& e, const Intrinsics& K, const Pose& pose) {
+  ImageAreaBounds b;
+  if (!e.valid) return b;
+  const Eigen::Vector3d x = pose.rotation() * e.ellipsoid.center() + pose.translation();
+  const double d2 = x.squaredNorm(), z2 = x(2) * x(2), pixels = K.fx * K.fy;
+  const auto sphere = [&](double r) {
+    const double h = z2 - r * r;
+    return pixels * M_PI * r * r * std::sqrt(d2 - r * r) / (h * std::sqrt(h));
+  };
+  const double r_min = e.smallest_axis, r_max = e.largest_axis;
+  if (!(x(2) > r_min)) {
+    b.lower = INFINITY;
+    return b;
+  }
+  const Eigen::Vector3d u = pose.rotation().transpose() * x;  // the line of sight (|u| = D) in the world
+  const double section = M_PI * e.axes_product * std::sqrt(d2 / u.dot(e.shape * u));
+  const double spread = d2 + r_max * r_max;
+  b.lower = std::max(sphere(r_min), pixels * section * std::sqrt(d2) / (spread * std::sqrt(spread)));
+  if (x(2) > r_max) b.upper = sphere(r_max);
+  return b;
+}
 
 namespace detail {
 

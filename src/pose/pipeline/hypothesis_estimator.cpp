@@ -69,10 +69,23 @@ int HypothesisEstimator::generate(const int* s, Model* models) const {
     // A correction moves a pose by millimetres to centimetres (accept() gates the corrected
     // pose again); the rare one that jumps to another P3P branch is no correction of this pose.
     if (!gate_.admits(m.pose)) continue;
+    // Two in five P3P poses put an own object where its image is certainly too large or too
+    // small for its observation: area bounds show it in a few operations, before the correction
+    // and the projections. A correction moves a pose far less than the factor 1 / min_overlap in
+    // area that this tolerates.
+    if (options_.search.check_sample_overlap && !ownSizesMayFit(m.pose, s)) continue;
     if (options_.search.correct_centres && !correctCentres(s, &m.pose)) continue;
     if (accept(m.pose, s, 3, options_.search.check_sample_overlap, &m.own)) models[count++] = m;
   }
   return count;
+}
+
+bool HypothesisEstimator::ownSizesMayFit(const Pose& pose, const int* s) const {
+  for (int k = 0; k < 3; ++k) {
+    const CandidatePair& c = pairs_[s[k]];
+    if (!scorer_.sizeMayReach(observations_[c.observation], c.object, pose, options_.scoring.min_overlap)) return false;
+  }
+  return true;
 }
 
 /// The centre of a projected ellipsoid's image is not the image of its centre: remove that

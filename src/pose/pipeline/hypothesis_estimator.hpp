@@ -70,6 +70,9 @@ class HypothesisEstimator {
   /// The gate, then every own pair in view and, with `check_overlap`, overlapping its
   /// observation by scoring.min_overlap; fills `own`.
   bool accept(const Pose& pose, const int* pair_indices, int count, bool check_overlap, KnownProjections* own) const;
+  /// Whether each of a sample's three objects may image large or small enough to overlap its
+  /// observation by scoring.min_overlap (PoseScorer::sizeMayReach).
+  bool ownSizesMayFit(const Pose& pose, const int* sample) const;
   bool correctCentres(const int* pair_indices, Pose* pose) const;
   void fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,
                   std::vector<Model>* out) const;

@@ -42,6 +42,15 @@ class PoseScorer {
   }
   /// False when the overlap's upper bound already shows that it is below `threshold`.
   bool overlapMayReach(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
+  /// False when the image of map object j at `pose` is certainly too large or too small to
+  /// overlap observation o by `threshold` under the ellipse IoU, which is at most the ratio of the
+  /// two areas (imageAreaBounds: no projection). j must be a candidate of some observation.
+  bool sizeMayReach(const Observation& o, int j, const Pose& pose, double threshold) const {
+    if (options_.overlap != OverlapMeasure::EllipseIoU) return true;
+    const ImageAreaBounds b = imageAreaBounds(prepared_[static_cast<size_t>(j)], K_, pose);
+    const double area = o.ellipse.area();
+    return !(area < threshold * b.lower * (1 - 1e-9) || threshold * area > b.upper * (1 + 1e-9));
+  }
   /// True when the overlap's lower bound already shows that it reaches `threshold`.
   bool overlapCertainlyReaches(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
 
