@@ -17,11 +17,14 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
   for (const auto& c : cands)
     for (int j : c) relevant[static_cast<size_t>(j)] = 1;
   candidate_area_.assign(map.objects.size(), Box(INFINITY, INFINITY, -INFINITY, -INFINITY));
+  candidate_boxes_.resize(map.objects.size());
   for (size_t i = 0; i < cands.size(); ++i)
     for (int j : cands[i]) {
+      if (!candidates.usable[i]) continue;  // never scored
       Box& a = candidate_area_[static_cast<size_t>(j)];
       const Box& b = observations[i].box;
       a = Box(std::min(a.x1, b.x1), std::min(a.y1, b.y1), std::max(a.x2, b.x2), std::max(a.y2, b.y2));
+      candidate_boxes_[static_cast<size_t>(j)].push_back(b);
     }
   prepared_.resize(map.objects.size());
   for (size_t j = 0; j < relevant.size(); ++j)
@@ -49,18 +52,24 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
 namespace {
 
 /// Whether the image of an ellipsoid (centre c, largest semi-axis r) under a valid pose
-/// certainly misses `area`: the image lies within that of the cube of side 2r around c, whose
-/// extremes are at its corners when the cube is in front of the camera. A pixel of margin keeps
-/// the test conservative under rounding.
-bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, const Intrinsics& K, const Box& area) {
+/// certainly misses every box of `boxes`: it lies within the image of the sphere of radius r
+/// about c, whose bounding box comes from the planes through the camera centre tangent to the
+/// sphere, u = (x z -+ r sqrt(x^2 + z^2 - r^2)) / (z^2 - r^2) (camera coordinates; v likewise).
+/// `area` bounds the boxes, for a first test. A pixel of margin keeps the test conservative
+/// under rounding.
+bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, const Intrinsics& K, const Box& area,
+                      const std::vector<Box>& boxes) {
   const Eigen::Vector3d x = pose.rotation() * c + pose.translation();
-  const double z_near = x(2) - r, z_far = x(2) + r;
-  if (!(z_near > 0.0)) return false;
-  const double u1 = std::min((x(0) - r) / z_near, (x(0) - r) / z_far) * K.fx + K.cx - 1.0;
-  const double u2 = std::max((x(0) + r) / z_near, (x(0) + r) / z_far) * K.fx + K.cx + 1.0;
-  const double v1 = std::min((x(1) - r) / z_near, (x(1) - r) / z_far) * K.fy + K.cy - 1.0;
-  const double v2 = std::max((x(1) + r) / z_near, (x(1) + r) / z_far) * K.fy + K.cy + 1.0;
-  return u2 <= area.x1 || area.x2 <= u1 || v2 <= area.y1 || area.y2 <= v1;
+  const double r2 = r * r, h = x(2) * x(2) - r2;
+  if (!(x(2) > r)) return false;
+  const double su = r * std::sqrt(x(0) * x(0) + h), sv = r * std::sqrt(x(1) * x(1) + h);
+  const double u1 = (x(0) * x(2) - su) / h * K.fx + K.cx - 1.0, u2 = (x(0) * x(2) + su) / h * K.fx + K.cx + 1.0;
+  const double v1 = (x(1) * x(2) - sv) / h * K.fy + K.cy - 1.0, v2 = (x(1) * x(2) + sv) / h * K.fy + K.cy + 1.0;
+  const auto misses = [&](const Box& b) { return u2 <= b.x1 || b.x2 <= u1 || v2 <= b.y1 || b.y2 <= v1; };
+  if (misses(area)) return true;
+  for (const Box& b : boxes)
+    if (!misses(b)) return false;
+  return true;
 }
 
 }  // namespace
@@ -130,8 +139,8 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     // Most objects are out of view at most poses: a cheap test spares their projection.
     const ProjectableEllipsoid& e = prepared_[static_cast<size_t>(j)];
     if (P && e.valid &&
-        certainlyOutside(e.ellipsoid.center(), e.ellipsoid.axes().maxCoeff(), pose, K_,
-                         candidate_area_[static_cast<size_t>(j)])) {
+        certainlyOutside(e.ellipsoid.center(), e.largest_axis, pose, K_, candidate_area_[static_cast<size_t>(j)],
+                         candidate_boxes_[static_cast<size_t>(j)])) {
       projects_[j] = 0;
       continue;
     }

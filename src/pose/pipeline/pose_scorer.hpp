@@ -97,6 +97,7 @@ class PoseScorer {
   std::vector<int> relevant_;                      // objects that are some observation's candidate
   std::vector<ProjectableEllipsoid> prepared_;     // per map object (filled for the relevant ones)
   std::vector<Box> candidate_area_;                // per map object: the union of its observations' boxes
+  std::vector<std::vector<Box>> candidate_boxes_;  // per map object: its observations' boxes
   std::vector<std::vector<double>> label_weight_;  // per observation, per candidate
   // Scratch, reused across calls.
   std::vector<Ellipse> projected_;
