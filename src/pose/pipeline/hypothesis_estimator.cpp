@@ -72,7 +72,7 @@ int HypothesisEstimator::generate(const int* s, Model* models) const {
     // Two in five P3P poses put an own object where its image is certainly too large or too
     // small for its observation: area bounds show it in a few operations, before the correction
     // and the projections. A correction moves a pose far less than the factor 1 / min_overlap in
-    // area that this tolerates.
+    // area that this tolerates; the few poses it would carry past it jump to another P3P root.
     if (options_.search.check_sample_overlap && !ownSizesMayFit(m.pose, s)) continue;
     if (options_.search.correct_centres && !correctCentres(s, &m.pose)) continue;
     if (accept(m.pose, s, 3, options_.search.check_sample_overlap, &m.own)) models[count++] = m;
