@@ -1,6 +1,7 @@
 // `ellreloc evaluate`.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
@@ -95,22 +96,32 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
   Evaluation e;
   std::vector<double> times;        // each query frame's time, under which the estimates write its pose
   std::vector<size_t> truth_index;  // its ground-truth pose
+  std::vector<double> frame_times;  // every frame's time, with a ground-truth pose or not
   if (!a.detections.empty()) {
     for (const DetectionFrame& f : io::readDetections(a.detections))
-      if (const auto t = f.timestamp())
+      if (const auto t = f.timestamp()) {
+        frame_times.push_back(*t);
         if (const auto g = io::findNearest(gt, *t))
           e.frames.push_back(f.timestampText()), times.push_back(*t), truth_index.push_back(*g);
+      }
   } else {
+    e.frames_are_groundtruth = true;
     for (size_t g = 0; g < gt.size(); ++g) {
       char text[32];
       std::snprintf(text, sizeof text, "%.6f", gt[g].timestamp);
       e.frames.push_back(gt[g].stamp.empty() ? text : gt[g].stamp);
       times.push_back(gt[g].timestamp);
+      frame_times.push_back(gt[g].timestamp);
       truth_index.push_back(g);
     }
   }
   if (e.frames.empty()) throw Error(a.groundtruth + ": no query frame has a ground-truth pose");
   for (size_t g : truth_index) e.truth.push_back(gt[g].pose.center());
+  std::sort(frame_times.begin(), frame_times.end());
+  const auto isFrameTime = [&](double t) {  // within the matching tolerance below
+    const auto it = std::lower_bound(frame_times.begin(), frame_times.end(), t - 1e-4);
+    return it != frame_times.end() && *it <= t + 1e-4;
+  };
   for (const auto& [path, label] : estimates) {
     // An estimate without poses is a run that relocalized nothing: 0% valid, not an error.
     const std::vector<io::StampedPose> est = io::readTumTrajectory(path, /*allow_empty=*/true);
@@ -121,6 +132,8 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
       m.centres.push_back(k ? std::optional(est[*k].pose.center()) : std::nullopt);
     }
     m.summary = summarize(m.errors);
+    m.poses = est.size();
+    for (const io::StampedPose& p : est) m.unmatched += !isFrameTime(p.timestamp);
     e.methods.push_back(std::move(m));
   }
   return e;
@@ -149,6 +162,14 @@ void printEvaluation(const Evaluation& e) {
       std::printf("| %.1f | %.2f | %.1f | %d / %d | %s |\n", s.median_position_cm, s.median_rotation_deg,
                   s.validPercent(), s.relocalized, s.frames, m.label.c_str());
   }
+  // Poses at no frame's time are left out of the table: say so, e.g. when the ground truth
+  // is a motion-capture trajectory sampled apart from the camera's frames.
+  for (const MethodEvaluation& m : e.methods)
+    if (m.unmatched > 0)
+      std::fprintf(
+          stderr, "warning: %s: %zu of its %zu poses are at no frame's time (within 0.1 ms)%s\n", m.path.c_str(),
+          m.unmatched, m.poses,
+          e.frames_are_groundtruth ? "; without --detections the query frames are the ground-truth poses" : "");
 }
 
 }  // namespace ellreloc::cli

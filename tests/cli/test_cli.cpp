@@ -83,6 +83,28 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
           dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("| - | - | 0.0 | 0 / 12 | nothing |"), std::string::npos) << r.out;
+  // A pose at no frame's time (e.g. a motion-capture ground truth without --detections) is
+  // named in a warning, not silently left out; a pose at a frame's time is not.
+  {
+    std::istringstream truth(readFile(s + "/query/groundtruth.txt"));
+    std::string line;
+    while (std::getline(truth, line) && (line.empty() || line[0] == '#')) {
+    }
+    std::istringstream fields(line);
+    double t = 0;
+    std::string rest;
+    fields >> t;
+    std::getline(fields, rest);
+    char shifted[64];
+    std::snprintf(shifted, sizeof shifted, "%.6f", t + 0.0123);
+    writeFile(dir.path("stray.txt"), line + "\n" + shifted + rest + "\n");
+  }
+  for (const std::string frames : {std::string(), " --detections " + s + "/query/detections.json"}) {
+    r = run("evaluate --groundtruth " + s + "/query/groundtruth.txt --estimate " + dir.path("stray.txt") + frames, dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("stray.txt: 1 of its 2 poses are at no frame's time"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("without --detections") != std::string::npos, frames.empty()) << r.err;
+  }
   // Keypoints matched to the map's points, from the detections file itself.
   r = run("relocalize --camera " + s + "/camera.yaml --map " + s + "/map_perturbed.json --detections " + s +
               "/query/detections.json --points --out " + dir.path("points.txt"),
