@@ -46,7 +46,7 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
   projects_.resize(map.objects.size(), 0);
   observation_taken_.resize(observations.size());
   object_taken_.resize(map.objects.size());
-  all_matches_.reserve(64);
+  pending_.reserve(64);
 }
 
 namespace {
@@ -157,32 +157,51 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     if (matches) matches->clear();
     return std::numeric_limits<double>::infinity();
   }
-  all_matches_.clear();
+  // Greedy one-to-one matching on credit, evaluated lazily: pairs leave a heap in order of
+  // their credit, or of its upper bound until their exact overlap is computed. An exact pair on
+  // top outranks every pair left, bounds included, so the matches and their order are those of
+  // sorting every exact credit, without the exact overlaps of pairs whose observation or object
+  // is taken before they come up.
+  pending_.clear();
   size_t pair = 0;  // the pairs come in the order costLowerBound kept their bounds in
   forEachNearbyPair([&](size_t i, size_t c, int j) {
-    const Observation& o = observations_[i];
-    double ov = 0.0;
-    if (!bounded)
-      ov = overlapReaching(o, projected_[j], vertices, options_.min_overlap);
-    else if (pair_bounds_[pair++] >= options_.min_overlap - 1e-9)  // overlapReaching's test, bound known
-      ov = overlap(o, projected_[j], vertices);
-    if (ov >= options_.min_overlap) all_matches_.push_back({static_cast<int>(i), j, ov, ov * label_weight_[i][c]});
+    const double bound = bounded ? pair_bounds_[pair++]
+                         : options_.overlap == OverlapMeasure::EllipseIoU
+                             ? ellipseIoUUpperBound(observations_[i].ellipse, projected_[j], vertices)
+                             : 1.0;
+    if (bound < options_.min_overlap - 1e-9) return;  // overlapReaching's test
+    const double weight = label_weight_[i][c];
+    // Raised by a rounding margin, so that no bound falls below its exact credit.
+    pending_.push_back({std::min(1.0, bound) * weight + 1e-9, weight, static_cast<int>(i), j, false});
   });
-  std::sort(all_matches_.begin(), all_matches_.end(), [](const ObjectCorrespondence& a, const ObjectCorrespondence& b) {
-    return a.credit != b.credit
-               ? a.credit > b.credit
-               : (a.observation != b.observation ? a.observation < b.observation : a.object < b.object);
-  });
+  const auto ranksBelow = [](const PendingPair& a, const PendingPair& b) {
+    if (a.key != b.key) return a.key < b.key;
+    return a.observation != b.observation ? a.observation > b.observation : a.object > b.object;
+  };
+  std::make_heap(pending_.begin(), pending_.end(), ranksBelow);
   std::fill(observation_taken_.begin(), observation_taken_.end(), 0);
   std::fill(object_taken_.begin(), object_taken_.end(), 0);
   const double miss = options_.unmatched_cost;
   double total = miss * candidates_.num_usable;
   if (matches) matches->clear();
-  for (const ObjectCorrespondence& m : all_matches_) {
-    if (observation_taken_[m.observation] || object_taken_[m.object]) continue;
-    observation_taken_[m.observation] = object_taken_[m.object] = 1;
-    total += (1.0 - m.credit) - miss;
-    if (matches) matches->push_back(m);
+  while (!pending_.empty()) {
+    std::pop_heap(pending_.begin(), pending_.end(), ranksBelow);
+    PendingPair p = pending_.back();
+    pending_.pop_back();
+    if (observation_taken_[p.observation] || object_taken_[p.object]) continue;
+    if (!p.exact) {
+      const double ov = overlap(observations_[p.observation], projected_[p.object], vertices);
+      if (ov < options_.min_overlap) continue;
+      p.overlap = ov;
+      p.key = ov * p.weight;
+      p.exact = true;
+      pending_.push_back(p);
+      std::push_heap(pending_.begin(), pending_.end(), ranksBelow);
+      continue;
+    }
+    observation_taken_[p.observation] = object_taken_[p.object] = 1;
+    total += (1.0 - p.key) - miss;
+    if (matches) matches->push_back({p.observation, p.object, p.overlap, p.key});
   }
   return total;
 }

@@ -103,7 +103,14 @@ class PoseScorer {
   std::vector<Ellipse> projected_;
   std::vector<Box> projected_box_;  // the bounding box of each projected_ ellipse
   std::vector<char> projects_;
-  std::vector<ObjectCorrespondence> all_matches_;
+  /// A pair waiting in cost()'s matching: key is its credit once exact, else the credit's bound.
+  struct PendingPair {
+    double key, weight;
+    int observation, object;
+    bool exact;
+    double overlap = 0.0;
+  };
+  std::vector<PendingPair> pending_;
   std::vector<char> observation_taken_, object_taken_;
   std::vector<double> pair_bounds_, best_gain_;
 };
