@@ -174,7 +174,10 @@ void map(const MapArgs& a, const Console& console) {
     console.progress("map", i + 1, frames.size());
   }
   console.endProgress();
-  if (used == 0) throw Error(a.detections + ": no frame has both a pose in " + a.trajectory + " and its depth");
+  if (used == 0)
+    throw Error(a.detections + ": no frame has " +
+                (options.mode == MappingMode::Voxel ? "both a pose in " + a.trajectory + " and its depth"
+                                                    : "a pose in " + a.trajectory + " (within 0.02 s)"));
   mapper.finish();
   ObjectMap result = mapper.map();
   // Objects relocalization could not use (mapObjectProblem) are left out of the file, and said.

@@ -328,6 +328,9 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
   writeFile(dir.path("no_time.json"), "[{\"file_name\": \"rgb/first.png\"" + frame + "]");
   const std::string out = dir.path("out.txt");
   const std::string reloc = "relocalize --camera " + d + "/camera.yaml --out " + out + " ";
+  const std::string boxes_of_other_frames = "map --mode boxes --camera " + d + "/camera.yaml --trajectory " +
+                                            data("tum_fr3_office_first_half") + "/groundtruth.txt --detections " + d +
+                                            "/keyframes.detections.json --out " + out;
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"missing file", reloc + "--map " + d + "/map.json --detections " + dir.path("nope.json")},
       {"empty file", reloc + "--map " + d + "/map.json --detections " + dir.path("empty.json")},
@@ -349,6 +352,7 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
       {"voxel map without depth", "map --camera " + d + "/camera.yaml --trajectory " + d +
                                       "/keyframes.groundtruth.txt --detections " + d +
                                       "/keyframes.detections.json --out " + out},
+      {"boxes map of frames without a pose", boxes_of_other_frames},
       {"unknown preset", "simulate --preset mars --out " + dir.path("scene")},
       {"zero gravity", reloc + "--map " + d + "/map.json --detections " + d +
                            "/keyframes.detections.json --camera-up 0,0,0 --map-up 0,0,1"},
@@ -385,6 +389,8 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
   };
   for (const auto& [name, args] : cases) {
     const CliRun r = run(args, dir);
+    if (args == boxes_of_other_frames)  // a boxes map needs poses, not depth: the message says so
+      EXPECT_NE(r.err.find("no frame has a pose in"), std::string::npos) << r.err;
     EXPECT_EQ(r.code, 2) << name << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1) << name << ": " << r.err;
     EXPECT_EQ(r.err.rfind("ellreloc: ", 0), 0u) << name << ": " << r.err;
