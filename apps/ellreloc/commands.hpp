@@ -108,7 +108,8 @@ struct Evaluation {
   bool frames_are_groundtruth = false;  ///< no --detections: every ground-truth pose is a query frame
 };
 CLI::App* addEvaluateCommand(CLI::App& app, EvaluateArgs& a);
-/// Reads and scores every estimate; writes nothing.
+/// Reads and scores every estimate; writes no file (a warning on stderr names the estimates with
+/// poses at no frame's time).
 Evaluation evaluateEstimates(const EvaluateArgs& a);
 /// evaluateEstimates, then --plot and --per-frame.
 Evaluation evaluate(const EvaluateArgs& a);

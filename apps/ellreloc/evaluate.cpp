@@ -136,6 +136,14 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
     for (const io::StampedPose& p : est) m.unmatched += !isFrameTime(p.timestamp);
     e.methods.push_back(std::move(m));
   }
+  // Poses at no frame's time are left out of every figure: say so, e.g. when the ground truth
+  // is a motion-capture trajectory sampled apart from the camera's frames.
+  for (const MethodEvaluation& m : e.methods)
+    if (m.unmatched > 0)
+      std::fprintf(
+          stderr, "warning: %s: %zu of its %zu poses are at no frame's time (within 0.1 ms)%s\n", m.path.c_str(),
+          m.unmatched, m.poses,
+          e.frames_are_groundtruth ? "; without --detections the query frames are the ground-truth poses" : "");
   return e;
 }
 
@@ -162,14 +170,6 @@ void printEvaluation(const Evaluation& e) {
       std::printf("| %.1f | %.2f | %.1f | %d / %d | %s |\n", s.median_position_cm, s.median_rotation_deg,
                   s.validPercent(), s.relocalized, s.frames, m.label.c_str());
   }
-  // Poses at no frame's time are left out of the table: say so, e.g. when the ground truth
-  // is a motion-capture trajectory sampled apart from the camera's frames.
-  for (const MethodEvaluation& m : e.methods)
-    if (m.unmatched > 0)
-      std::fprintf(
-          stderr, "warning: %s: %zu of its %zu poses are at no frame's time (within 0.1 ms)%s\n", m.path.c_str(),
-          m.unmatched, m.poses,
-          e.frames_are_groundtruth ? "; without --detections the query frames are the ground-truth poses" : "");
 }
 
 }  // namespace ellreloc::cli
