@@ -107,15 +107,18 @@ void PoseScorer::forEachNearbyPair(F f) const {
   }
 }
 
+double PoseScorer::pairBound(size_t i, int j, int vertices) const {
+  const Observation& o = observations_[i];
+  return options_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, projected_box_[j])
+                                                    : ellipseIoUUpperBound(o.ellipse, projected_[j], vertices);
+}
+
 double PoseScorer::costLowerBound(int vertices) {
   const double miss = options_.unmatched_cost;
   pair_bounds_.clear();
   best_gain_.assign(observations_.size(), 0.0);  // an observation left unmatched gains nothing
   forEachNearbyPair([&](size_t i, size_t c, int j) {
-    const Observation& o = observations_[i];
-    const double ub = options_.overlap == OverlapMeasure::BoxIoU
-                          ? boxIoU(o.box, projected_box_[j])
-                          : ellipseIoUUpperBound(o.ellipse, projected_[j], vertices);
+    const double ub = pairBound(i, j, vertices);
     pair_bounds_.push_back(ub);
     if (ub < options_.min_overlap - 1e-9) return;
     best_gain_[i] = std::max(best_gain_[i], miss - 1.0 + std::min(1.0, ub + 1e-9) * label_weight_[i][c]);
@@ -165,11 +168,8 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
   pending_.clear();
   size_t pair = 0;  // the pairs come in the order costLowerBound kept their bounds in
   forEachNearbyPair([&](size_t i, size_t c, int j) {
-    const double bound = bounded ? pair_bounds_[pair++]
-                         : options_.overlap == OverlapMeasure::EllipseIoU
-                             ? ellipseIoUUpperBound(observations_[i].ellipse, projected_[j], vertices)
-                             : 1.0;
-    if (bound < options_.min_overlap - 1e-9) return;  // overlapReaching's test
+    const double bound = bounded ? pair_bounds_[pair++] : pairBound(i, j, vertices);
+    if (bound < options_.min_overlap - 1e-9) return;  // overlapMayReach's margin
     const double weight = label_weight_[i][c];
     // Raised by a rounding margin, so that no bound falls below its exact credit.
     pending_.push_back({std::min(1.0, bound) * weight + 1e-9, weight, static_cast<int>(i), j, false});

@@ -34,12 +34,6 @@ class PoseScorer {
 
   /// The overlap of an observation and a projected ellipse under the options' measure.
   double overlap(const Observation& o, const Ellipse& projected, int vertices) const;
-  /// overlap(o, projected, vertices), or 0 when its upper bound already shows that it is below
-  /// `threshold` (the exact ellipse IoU costs an atan2 per polygon vertex; the bound a few
-  /// operations).
-  double overlapReaching(const Observation& o, const Ellipse& projected, int vertices, double threshold) const {
-    return overlapMayReach(o, projected, vertices, threshold) ? overlap(o, projected, vertices) : 0.0;
-  }
   /// False when the overlap's upper bound already shows that it is below `threshold`.
   bool overlapMayReach(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
   /// False when the image of map object j at `pose` is certainly too large or too small to
@@ -86,6 +80,9 @@ class PoseScorer {
   /// project with a box overlapping the observation's, in a fixed order.
   template <typename F>
   void forEachNearbyPair(F f) const;
+  /// An upper bound of the overlap of observation i and object j's current projection (under
+  /// box IoU, the overlap itself): a few operations.
+  double pairBound(size_t i, int j, int vertices) const;
   /// unmatched_cost per usable observation less, for each, the most its best projected
   /// candidate could gain by the overlap bound: no exact overlap is computed. Keeps each pair's
   /// bound (pair_bounds_, in forEachNearbyPair's order) for the exact pass.
