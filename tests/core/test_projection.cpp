@@ -30,6 +30,14 @@ std::vector<Eigen::Vector3d> occludingContour(const Ellipsoid& e, const Eigen::V
   return points;
 }
 
+/// An ellipsoid within 2 m of the origin, semi-axes of 1 cm to 1 m (often needles or discs), any
+/// rotation: in front of, behind, around and across a camera near the origin.
+Ellipsoid randomPlacement(std::mt19937& rng) {
+  return Ellipsoid({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
+                   {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
+                   ellreloc::test::randomRotation(rng));
+}
+
 }  // namespace
 
 TEST(Projection, SurfaceProjectsInsideAndContourOnTheEllipse) {
@@ -115,9 +123,7 @@ TEST(Projection, FailuresAreStatusesNotNaN) {
   std::mt19937 rng(23);
   int ok = 0, failed = 0;
   for (int i = 0; i < 2000; ++i) {
-    const Ellipsoid e({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
-                      {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
-                      ellreloc::test::randomRotation(rng));
+    const Ellipsoid e = randomPlacement(rng);
     const Eigen::Vector3d t(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
     const Pose pose(ellreloc::test::randomRotation(rng), t);
     const Projection p = project(e, K, pose);
@@ -145,9 +151,7 @@ TEST(Projection, ImageAreaBoundsHoldAtRandomPoses) {
   std::mt19937 rng(25);
   int ok = 0, failed = 0, lower_useful = 0, upper_useful = 0;
   for (int i = 0; i < 4000; ++i) {
-    const Ellipsoid e({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
-                      {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
-                      ellreloc::test::randomRotation(rng));
+    const Ellipsoid e = randomPlacement(rng);
     const Pose pose(ellreloc::test::randomRotation(rng), {uniform(rng, -1, 1), uniform(rng, -1, 1), 0.0});
     const Projection p = project(e, K, pose);
     const ImageAreaBounds b = imageAreaBounds(ProjectableEllipsoid(e), K, pose);
@@ -198,9 +202,7 @@ TEST(Projection, CentreAloneIsTheCentreOfTheWholeProjection) {
   std::mt19937 rng(24);
   int ok = 0, failed = 0;
   for (int i = 0; i < 2000; ++i) {
-    const Ellipsoid e({uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, -2, 2)},
-                      {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)},
-                      ellreloc::test::randomRotation(rng));
+    const Ellipsoid e = randomPlacement(rng);
     const Projection whole = project(e, K, identity);
     const std::optional<Eigen::Vector2d> centre =
         projectedCentre(ProjectableEllipsoid(e), projectionMatrix(K, identity));

@@ -17,22 +17,48 @@
 
 using namespace ellreloc;
 
+namespace {
+
+/// 25 objects of four categories (look-alikes) within +-spread m of the origin in x and y and
+/// +-0.3 m in z, observed from a random pose looking at them, with 3 px of centre noise.
+struct Scene {
+  ObjectMap map;
+  Pose truth;
+  std::vector<Observation> observations;
+};
+
+Scene randomScene(double spread, const Intrinsics& K, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Scene s;
+  for (int i = 0; i < 25; ++i)
+    s.map.objects.push_back(
+        {i, i % 4, "",
+         Ellipsoid({spread * u(rng), spread * u(rng), 0.3 * u(rng)},
+                   {0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng)}, Eigen::Matrix3d::Identity())});
+  s.truth = test::randomLookAtPose(rng);
+  sim::MapObservationOptions noise;
+  noise.centre_sigma_px = 3.0;
+  s.observations = sim::observeMap(s.map, K, s.truth, noise, &rng);
+  return s;
+}
+
+/// The truth turned by up to `step` radians and moved by up to `step` m along each axis.
+Pose offTheTruth(const Pose& truth, double step, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return Pose(
+      Eigen::AngleAxisd(step * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix() *
+          truth.rotation(),
+      truth.translation() + step * Eigen::Vector3d(u(rng), u(rng), u(rng)));
+}
+
+}  // namespace
+
 TEST(PoseScorer, GivingUpIsExactOrProvablyAboveTheThreshold) {
   std::mt19937 rng(91);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   const Intrinsics K = test::testIntrinsics();
   int given_up = 0, exact = 0;
   for (int scene = 0; scene < 20; ++scene) {
-    ObjectMap map;
-    for (int i = 0; i < 25; ++i)
-      map.objects.push_back(
-          {i, i % 4, "",
-           Ellipsoid({1.2 * u(rng), 1.2 * u(rng), 0.3 * u(rng)},
-                     {0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng)}, Eigen::Matrix3d::Identity())});
-    const Pose truth = test::randomLookAtPose(rng);
-    sim::MapObservationOptions noise;
-    noise.centre_sigma_px = 3.0;
-    const std::vector<Observation> observations = sim::observeMap(map, K, truth, noise, &rng);
+    const auto [map, truth, observations] = randomScene(1.2, K, rng);
     for (const ScoringOptions& options : {RelocalizerOptions().scoring, RelocalizerOptions::oaSlam().scoring}) {
       std::vector<std::pair<int, std::string>> skipped;
       const pipeline::Candidates candidates =
@@ -40,11 +66,7 @@ TEST(PoseScorer, GivingUpIsExactOrProvablyAboveTheThreshold) {
       pipeline::PoseScorer scorer(observations, candidates, map, K, options);
       for (int k = 0; k < 40; ++k) {
         // Poses from near the truth to far off it, so that costs span the whole range.
-        const double step = 0.02 * k;
-        const Pose pose = Pose(
-            Eigen::AngleAxisd(step * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix() *
-                truth.rotation(),
-            truth.translation() + step * Eigen::Vector3d(u(rng), u(rng), u(rng)));
+        const Pose pose = offTheTruth(truth, 0.02 * k, rng);
         const double full = scorer.cost(pose, pipeline::kRankingIoUVertices);
         for (const double threshold : {full - 0.5, full, full + 1e-6, full + 0.5, 0.0, 1.0, 3.0}) {
           std::vector<ObjectCorrespondence> matches;
@@ -70,31 +92,17 @@ TEST(PoseScorer, GivingUpIsExactOrProvablyAboveTheThreshold) {
 // plain projections.
 TEST(PoseScorer, MatchesAreTheGreedyMatchingOfEveryExactOverlap) {
   std::mt19937 rng(92);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   const Intrinsics K = test::testIntrinsics();
   int matched = 0, contested = 0;
   for (int scene = 0; scene < 20; ++scene) {
-    ObjectMap map;
-    for (int i = 0; i < 25; ++i)  // four categories of look-alikes, packed closely
-      map.objects.push_back(
-          {i, i % 4, "",
-           Ellipsoid({0.8 * u(rng), 0.8 * u(rng), 0.3 * u(rng)},
-                     {0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng)}, Eigen::Matrix3d::Identity())});
-    const Pose truth = test::randomLookAtPose(rng);
-    sim::MapObservationOptions noise;
-    noise.centre_sigma_px = 3.0;
-    const std::vector<Observation> observations = sim::observeMap(map, K, truth, noise, &rng);
+    const auto [map, truth, observations] = randomScene(0.8, K, rng);  // packed more closely
     for (const ScoringOptions& options : {RelocalizerOptions().scoring, RelocalizerOptions::oaSlam().scoring}) {
       std::vector<std::pair<int, std::string>> skipped;
       const pipeline::Candidates candidates =
           pipeline::collectCandidates(observations, map, options, 1000000, &skipped);
       pipeline::PoseScorer scorer(observations, candidates, map, K, options);
       for (int k = 0; k < 20; ++k) {
-        const double step = 0.02 * k;
-        const Pose pose(
-            Eigen::AngleAxisd(step * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix() *
-                truth.rotation(),
-            truth.translation() + step * Eigen::Vector3d(u(rng), u(rng), u(rng)));
+        const Pose pose = offTheTruth(truth, 0.02 * k, rng);
         std::vector<ObjectCorrespondence> matches;
         const double cost = scorer.cost(pose, pipeline::kRankingIoUVertices, &matches);
         // Every candidate pair's exact overlap, sorted by credit (ties: observation, object).
