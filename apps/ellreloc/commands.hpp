@@ -98,14 +98,11 @@ struct MethodEvaluation {
   std::vector<std::optional<PoseError>> errors;         ///< per query frame; nullopt: no pose
   std::vector<std::optional<Eigen::Vector3d>> centres;  ///< per query frame: the estimated camera centre
   RelocalizationSummary summary;
-  size_t poses = 0;      ///< poses in the estimate file
-  size_t unmatched = 0;  ///< of them, at no frame's time: a sign of the wrong frames
 };
 struct Evaluation {
   std::vector<std::string> frames;     ///< the query frames' timestamps as written
   std::vector<Eigen::Vector3d> truth;  ///< their true camera centres
   std::vector<MethodEvaluation> methods;
-  bool frames_are_groundtruth = false;  ///< no --detections: every ground-truth pose is a query frame
 };
 CLI::App* addEvaluateCommand(CLI::App& app, EvaluateArgs& a);
 /// Reads and scores every estimate; writes no file (a warning on stderr names the estimates with

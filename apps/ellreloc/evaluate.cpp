@@ -105,7 +105,6 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
           e.frames.push_back(f.timestampText()), times.push_back(*t), truth_index.push_back(*g);
       }
   } else {
-    e.frames_are_groundtruth = true;
     for (size_t g = 0; g < gt.size(); ++g) {
       char text[32];
       std::snprintf(text, sizeof text, "%.6f", gt[g].timestamp);
@@ -132,18 +131,16 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
       m.centres.push_back(k ? std::optional(est[*k].pose.center()) : std::nullopt);
     }
     m.summary = summarize(m.errors);
-    m.poses = est.size();
-    for (const io::StampedPose& p : est) m.unmatched += !isFrameTime(p.timestamp);
     e.methods.push_back(std::move(m));
+    // Poses at no frame's time are left out of every figure: say so, e.g. when the ground truth
+    // is a motion-capture trajectory sampled apart from the camera's frames.
+    const auto unmatched = static_cast<size_t>(
+        std::count_if(est.begin(), est.end(), [&](const io::StampedPose& p) { return !isFrameTime(p.timestamp); }));
+    if (unmatched > 0)
+      std::fprintf(stderr, "warning: %s: %zu of its %zu poses are at no frame's time (within 0.1 ms)%s\n", path.c_str(),
+                   unmatched, est.size(),
+                   a.detections.empty() ? "; without --detections the query frames are the ground-truth poses" : "");
   }
-  // Poses at no frame's time are left out of every figure: say so, e.g. when the ground truth
-  // is a motion-capture trajectory sampled apart from the camera's frames.
-  for (const MethodEvaluation& m : e.methods)
-    if (m.unmatched > 0)
-      std::fprintf(
-          stderr, "warning: %s: %zu of its %zu poses are at no frame's time (within 0.1 ms)%s\n", m.path.c_str(),
-          m.unmatched, m.poses,
-          e.frames_are_groundtruth ? "; without --detections the query frames are the ground-truth poses" : "");
   return e;
 }
 
