@@ -109,7 +109,7 @@ struct ImageAreaBounds {
 inline ImageAreaBounds imageAreaBounds(const ProjectableEllipsoid& e, const Intrinsics& K, const Pose& pose) {
   ImageAreaBounds b;
   if (!e.valid) return b;
-  const Eigen::Vector3d x = pose.rotation() * e.ellipsoid.center() + pose.translation();
+  const Eigen::Vector3d x = pose.transform(e.ellipsoid.center());
   const double d2 = x.squaredNorm(), z2 = x(2) * x(2), pixels = K.fx * K.fy;
   const auto sphere = [&](double r) {
     const double h = z2 - r * r;

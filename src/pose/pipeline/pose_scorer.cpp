@@ -59,7 +59,7 @@ namespace {
 /// under rounding.
 bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, const Intrinsics& K, const Box& area,
                       const std::vector<Box>& boxes) {
-  const Eigen::Vector3d x = pose.rotation() * c + pose.translation();
+  const Eigen::Vector3d x = pose.transform(c);
   const double r2 = r * r, h = x(2) * x(2) - r2;
   if (!(x(2) > r)) return false;
   const double su = r * std::sqrt(x(0) * x(0) + h), sv = r * std::sqrt(x(1) * x(1) + h);
