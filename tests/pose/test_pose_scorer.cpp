@@ -21,15 +21,15 @@ namespace {
 
 /// 25 objects of four categories (look-alikes) within +-spread m of the origin in x and y and
 /// +-0.3 m in z, observed from a random pose looking at them, with 3 px of centre noise.
-struct Scene {
+struct ScorerScene {
   ObjectMap map;
   Pose truth;
   std::vector<Observation> observations;
 };
 
-Scene randomScene(double spread, const Intrinsics& K, std::mt19937& rng) {
+ScorerScene randomScorerScene(double spread, const Intrinsics& K, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Scene s;
+  ScorerScene s;
   for (int i = 0; i < 25; ++i)
     s.map.objects.push_back(
         {i, i % 4, "",
@@ -58,7 +58,7 @@ TEST(PoseScorer, GivingUpIsExactOrProvablyAboveTheThreshold) {
   const Intrinsics K = test::testIntrinsics();
   int given_up = 0, exact = 0;
   for (int scene = 0; scene < 20; ++scene) {
-    const auto [map, truth, observations] = randomScene(1.2, K, rng);
+    const auto [map, truth, observations] = randomScorerScene(1.2, K, rng);
     for (const ScoringOptions& options : {RelocalizerOptions().scoring, RelocalizerOptions::oaSlam().scoring}) {
       std::vector<std::pair<int, std::string>> skipped;
       const pipeline::Candidates candidates =
@@ -95,7 +95,7 @@ TEST(PoseScorer, MatchesAreTheGreedyMatchingOfEveryExactOverlap) {
   const Intrinsics K = test::testIntrinsics();
   int matched = 0, contested = 0;
   for (int scene = 0; scene < 20; ++scene) {
-    const auto [map, truth, observations] = randomScene(0.8, K, rng);  // packed more closely
+    const auto [map, truth, observations] = randomScorerScene(0.8, K, rng);  // packed more closely
     for (const ScoringOptions& options : {RelocalizerOptions().scoring, RelocalizerOptions::oaSlam().scoring}) {
       std::vector<std::pair<int, std::string>> skipped;
       const pipeline::Candidates candidates =
