@@ -128,6 +128,20 @@ double PoseScorer::costLowerBound(int vertices) {
   return bound;
 }
 
+double PoseScorer::gainStillPossible(const PendingPair& top) {
+  // Each observation not yet matched gains at most its best pair still open (one whose object
+  // is not taken either): by its exact credit, or by its bound until that is computed.
+  std::fill(open_key_.begin(), open_key_.end(), -std::numeric_limits<double>::infinity());
+  open_key_[static_cast<size_t>(top.observation)] = top.key;
+  for (const PendingPair& q : pending_)
+    if (!observation_taken_[q.observation] && !object_taken_[q.object])
+      open_key_[static_cast<size_t>(q.observation)] = std::max(open_key_[static_cast<size_t>(q.observation)], q.key);
+  const double miss = options_.unmatched_cost;
+  double gain = 0.0;
+  for (double key : open_key_) gain += std::max(0.0, miss - 1.0 + key);
+  return gain;
+}
+
 double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorrespondence>* matches,
                         const KnownProjections* known, double give_up_at) {
   const std::optional<Eigen::Matrix<double, 3, 4>> P = projectionAt(pose);  // checked once, not per object
@@ -164,7 +178,8 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
   // their credit, or of its upper bound until their exact overlap is computed. An exact pair on
   // top outranks every pair left, bounds included, so the matches and their order are those of
   // sorting every exact credit, without the exact overlaps of pairs whose observation or object
-  // is taken before they come up.
+  // is taken before they come up. As exact credits replace bounds, the cost may be shown to
+  // reach give_up_at before the matching ends: it gives up then, before the next exact overlap.
   pending_.clear();
   size_t pair = 0;  // the pairs come in the order costLowerBound kept their bounds in
   forEachNearbyPair([&](size_t i, size_t c, int j) {
@@ -181,6 +196,7 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
   std::make_heap(pending_.begin(), pending_.end(), ranksBelow);
   std::fill(observation_taken_.begin(), observation_taken_.end(), 0);
   std::fill(object_taken_.begin(), object_taken_.end(), 0);
+  open_key_.resize(observations_.size());
   const double miss = options_.unmatched_cost;
   double total = miss * candidates_.num_usable;
   if (matches) matches->clear();
@@ -190,6 +206,10 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     pending_.pop_back();
     if (observation_taken_[p.observation] || object_taken_[p.object]) continue;
     if (!p.exact) {
+      if (bounded && total - gainStillPossible(p) - 1e-9 >= give_up_at) {
+        if (matches) matches->clear();
+        return std::numeric_limits<double>::infinity();
+      }
       const double ov = overlap(observations_[p.observation], projected_[p.object], vertices);
       if (ov < options_.min_overlap) continue;
       p.overlap = ov;

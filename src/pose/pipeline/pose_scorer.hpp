@@ -87,6 +87,16 @@ class PoseScorer {
   /// candidate could gain by the overlap bound: no exact overlap is computed. Keeps each pair's
   /// bound (pair_bounds_, in forEachNearbyPair's order) for the exact pass.
   double costLowerBound(int vertices);
+  /// A pair waiting in cost()'s matching: key is its credit once exact, else the credit's bound.
+  struct PendingPair {
+    double key, weight;
+    int observation, object;
+    bool exact;
+    double overlap = 0.0;
+  };
+  /// During cost()'s matching, with `top` just taken off the heap: the most the observations
+  /// not yet matched could still take off the cost.
+  double gainStillPossible(const PendingPair& top);
   const std::vector<Observation>& observations_;
   const Candidates& candidates_;
   const Intrinsics& K_;
@@ -100,16 +110,9 @@ class PoseScorer {
   std::vector<Ellipse> projected_;
   std::vector<Box> projected_box_;  // the bounding box of each projected_ ellipse
   std::vector<char> projects_;
-  /// A pair waiting in cost()'s matching: key is its credit once exact, else the credit's bound.
-  struct PendingPair {
-    double key, weight;
-    int observation, object;
-    bool exact;
-    double overlap = 0.0;
-  };
   std::vector<PendingPair> pending_;
   std::vector<char> observation_taken_, object_taken_;
-  std::vector<double> pair_bounds_, best_gain_;
+  std::vector<double> pair_bounds_, best_gain_, open_key_;
 };
 
 }  // namespace ellreloc::pipeline
