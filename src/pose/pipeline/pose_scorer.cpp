@@ -17,14 +17,14 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
   for (const auto& c : cands)
     for (int j : c) relevant[static_cast<size_t>(j)] = 1;
   candidate_area_.assign(map.objects.size(), Box(INFINITY, INFINITY, -INFINITY, -INFINITY));
-  candidate_boxes_.resize(map.objects.size());
+  candidate_observations_.resize(map.objects.size());
   for (size_t i = 0; i < cands.size(); ++i)
     for (int j : cands[i]) {
       if (!candidates.usable[i]) continue;  // never scored
       Box& a = candidate_area_[static_cast<size_t>(j)];
       const Box& b = observations[i].box;
       a = Box(std::min(a.x1, b.x1), std::min(a.y1, b.y1), std::max(a.x2, b.x2), std::max(a.y2, b.y2));
-      candidate_boxes_[static_cast<size_t>(j)].push_back(b);
+      candidate_observations_[static_cast<size_t>(j)].push_back(static_cast<int>(i));
     }
   prepared_.resize(map.objects.size());
   for (size_t j = 0; j < relevant.size(); ++j)
@@ -52,13 +52,13 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
 namespace {
 
 /// Whether the image of an ellipsoid (centre c, largest semi-axis r) under a valid pose
-/// certainly misses every box of `boxes`: it lies within the image of the sphere of radius r
+/// certainly misses the box of each observation in `box_of`: it lies within the image of the sphere of radius r
 /// about c, whose bounding box comes from the planes through the camera centre tangent to the
 /// sphere, u = (x z -+ r sqrt(x^2 + z^2 - r^2)) / (z^2 - r^2) (camera coordinates; v likewise).
-/// `area` bounds the boxes, for a first test. A pixel of margin keeps the test conservative
+/// `area` bounds those boxes, for a first test. A pixel of margin keeps the test conservative
 /// under rounding.
 bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, const Intrinsics& K, const Box& area,
-                      const std::vector<Box>& boxes) {
+                      const std::vector<int>& box_of, const std::vector<Observation>& observations) {
   const Eigen::Vector3d x = pose.transform(c);
   const double r2 = r * r, h = x(2) * x(2) - r2;
   if (!(x(2) > r)) return false;
@@ -67,8 +67,8 @@ bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, cons
   const double v1 = (x(1) * x(2) - sv) / h * K.fy + K.cy - 1.0, v2 = (x(1) * x(2) + sv) / h * K.fy + K.cy + 1.0;
   const auto misses = [&](const Box& b) { return u2 <= b.x1 || b.x2 <= u1 || v2 <= b.y1 || b.y2 <= v1; };
   if (misses(area)) return true;
-  for (const Box& b : boxes)
-    if (!misses(b)) return false;
+  for (const int i : box_of)
+    if (!misses(observations[static_cast<size_t>(i)].box)) return false;
   return true;
 }
 
@@ -161,7 +161,7 @@ double PoseScorer::cost(const Pose& pose, int vertices, std::vector<ObjectCorres
     const ProjectableEllipsoid& e = prepared_[static_cast<size_t>(j)];
     if (P && e.valid &&
         certainlyOutside(e.ellipsoid.center(), e.largest_axis, pose, K_, candidate_area_[static_cast<size_t>(j)],
-                         candidate_boxes_[static_cast<size_t>(j)])) {
+                         candidate_observations_[static_cast<size_t>(j)], observations_)) {
       projects_[j] = 0;
       continue;
     }

@@ -101,11 +101,11 @@ class PoseScorer {
   const Candidates& candidates_;
   const Intrinsics& K_;
   const ScoringOptions& options_;
-  std::vector<int> relevant_;                      // objects that are some observation's candidate
-  std::vector<ProjectableEllipsoid> prepared_;     // per map object (filled for the relevant ones)
-  std::vector<Box> candidate_area_;                // per map object: the union of its observations' boxes
-  std::vector<std::vector<Box>> candidate_boxes_;  // per map object: its observations' boxes
-  std::vector<std::vector<double>> label_weight_;  // per observation, per candidate
+  std::vector<int> relevant_;                             // objects that are some observation's candidate
+  std::vector<ProjectableEllipsoid> prepared_;            // per map object (filled for the relevant ones)
+  std::vector<Box> candidate_area_;                       // per map object: the union of its observations' boxes
+  std::vector<std::vector<int>> candidate_observations_;  // per map object: the observations it may explain
+  std::vector<std::vector<double>> label_weight_;         // per observation, per candidate
   // Scratch, reused across calls.
   std::vector<Ellipse> projected_;
   std::vector<Box> projected_box_;  // the bounding box of each projected_ ellipse
