@@ -259,24 +259,36 @@ inline double ellipseIoU(const Ellipse& e1, const Ellipse& e2, int vertices = 12
   return uni > 0.0 ? std::clamp(inter / uni, 0.0, 1.0) : 0.0;
 }
 
+namespace detail {
+
+/// ellipseIoUUpperBound of two valid ellipses from their areas, centres and bounding boxes, for
+/// callers that keep these.
+inline double iouUpperBoundFromExtents(double area1, const Eigen::Vector2d& centre1, const Box& box1, double area2,
+                                       const Eigen::Vector2d& centre2, const Box& box2, int vertices) {
+  if (!std::isfinite(area1 + area2)) return 1.0;  // areas beyond a double: no bound
+  const bool first_is_polygon = area1 < area2;    // discAndPolygon's choice
+  const Box& s = first_is_polygon ? box1 : box2;
+  const Box& b = first_is_polygon ? box2 : box1;
+  const Eigen::Vector2d& c = first_is_polygon ? centre1 : centre2;
+  const double k = polygonConstants(vertices).k;
+  const double hx = 0.5 * k * s.width(), hy = 0.5 * k * s.height();
+  const double w = std::min(c(0) + hx, b.x2) - std::max(c(0) - hx, b.x1);
+  const double h = std::min(c(1) + hy, b.y2) - std::max(c(1) - hy, b.y1);
+  if (!(w > 0.0) || !(h > 0.0)) return 0.0;
+  const double inter = std::min(std::min(area1, area2), w * h);
+  return inter / (area1 + area2 - inter);
+}
+
+}  // namespace detail
+
 /// An upper bound of ellipseIoU(e1, e2, vertices) from the areas and the bounding boxes alone
 /// (the smaller ellipse's box widened by the polygon's radius factor, as the polygon may reach
 /// beyond the ellipse): a few operations instead of one atan2 per vertex, to skip pairs that
 /// cannot reach a threshold.
 inline double ellipseIoUUpperBound(const Ellipse& e1, const Ellipse& e2, int vertices = 128) {
   if (!e1.isValid() || !e2.isValid() || vertices < 3) return 0.0;
-  const double a1 = e1.area(), a2 = e2.area();
-  if (!std::isfinite(a1 + a2)) return 1.0;  // areas beyond a double: no bound
-  const auto [big, small] = detail::discAndPolygon(e1, e2, a1, a2);
-  const double k = detail::polygonConstants(vertices).k;
-  const Box s = small.boundingBox(), b = big.boundingBox();
-  const double hx = 0.5 * k * s.width(), hy = 0.5 * k * s.height();
-  const Eigen::Vector2d c = small.center();
-  const double w = std::min(c(0) + hx, b.x2) - std::max(c(0) - hx, b.x1);
-  const double h = std::min(c(1) + hy, b.y2) - std::max(c(1) - hy, b.y1);
-  if (!(w > 0.0) || !(h > 0.0)) return 0.0;
-  const double inter = std::min(std::min(a1, a2), w * h);
-  return inter / (a1 + a2 - inter);
+  return detail::iouUpperBoundFromExtents(e1.area(), e1.center(), e1.boundingBox(), e2.area(), e2.center(),
+                                          e2.boundingBox(), vertices);
 }
 
 /// A lower bound of ellipseIoU(e1, e2, vertices), a few operations instead of one atan2 per

@@ -44,6 +44,11 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
   projected_.resize(map.objects.size());
   projected_box_.resize(map.objects.size());
   projects_.resize(map.objects.size(), 0);
+  for (const Observation& o : observations) {
+    observation_valid_.push_back(o.ellipse.isValid());
+    observation_area_.push_back(o.ellipse.area());
+    observation_box_.push_back(o.ellipse.boundingBox());
+  }
   observation_taken_.resize(observations.size());
   object_taken_.resize(map.objects.size());
   pending_.reserve(64);
@@ -113,8 +118,13 @@ void PoseScorer::forEachNearbyPair(F f) const {
 
 double PoseScorer::pairBound(size_t i, int j, int vertices) const {
   const Observation& o = observations_[i];
-  return options_.overlap == OverlapMeasure::BoxIoU ? boxIoU(o.box, projected_box_[j])
-                                                    : ellipseIoUUpperBound(o.ellipse, projected_[j], vertices);
+  if (options_.overlap == OverlapMeasure::BoxIoU) return boxIoU(o.box, projected_box_[j]);
+  // ellipseIoUUpperBound(o.ellipse, projected_[j], vertices), from the extents kept (a projection
+  // that succeeded is a valid ellipse).
+  if (!observation_valid_[i]) return 0.0;
+  const Ellipse& p = projected_[j];
+  return detail::iouUpperBoundFromExtents(observation_area_[i], o.ellipse.center(), observation_box_[i], p.area(),
+                                          p.center(), projected_box_[j], vertices);
 }
 
 double PoseScorer::costLowerBound(int vertices) {

@@ -106,6 +106,10 @@ class PoseScorer {
   std::vector<Box> candidate_area_;                       // per map object: the union of its observations' boxes
   std::vector<std::vector<int>> candidate_observations_;  // per map object: the observations it may explain
   std::vector<std::vector<double>> label_weight_;         // per observation, per candidate
+  // Per observation: what the overlap bounds read of its ellipse.
+  std::vector<char> observation_valid_;
+  std::vector<double> observation_area_;
+  std::vector<Box> observation_box_;
   // Scratch, reused across calls.
   std::vector<Ellipse> projected_;
   std::vector<Box> projected_box_;  // the bounding box of each projected_ ellipse
