@@ -57,13 +57,13 @@ PoseScorer::PoseScorer(const std::vector<Observation>& observations, const Candi
 namespace {
 
 /// Whether the image of an ellipsoid (centre c, largest semi-axis r) under a valid pose
-/// certainly misses the box of each observation in `box_of`: it lies within the image of the sphere of radius r
-/// about c, whose bounding box comes from the planes through the camera centre tangent to the
-/// sphere, u = (x z -+ r sqrt(x^2 + z^2 - r^2)) / (z^2 - r^2) (camera coordinates; v likewise).
-/// `area` bounds those boxes, for a first test. A pixel of margin keeps the test conservative
-/// under rounding.
+/// certainly misses the boxes of the observations `which` (indices into `observations`): it lies
+/// within the image of the sphere of radius r about c, whose bounding box comes from the planes
+/// through the camera centre tangent to the sphere, u = (x z -+ r sqrt(x^2 + z^2 - r^2)) /
+/// (z^2 - r^2) (camera coordinates; v likewise). `area` bounds those boxes, for a first test. A
+/// pixel of margin keeps the test conservative under rounding.
 bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, const Intrinsics& K, const Box& area,
-                      const std::vector<int>& box_of, const std::vector<Observation>& observations) {
+                      const std::vector<int>& which, const std::vector<Observation>& observations) {
   const Eigen::Vector3d x = pose.transform(c);
   const double r2 = r * r, h = x(2) * x(2) - r2;
   if (!(x(2) > r)) return false;
@@ -72,7 +72,7 @@ bool certainlyOutside(const Eigen::Vector3d& c, double r, const Pose& pose, cons
   const double v1 = (x(1) * x(2) - sv) / h * K.fy + K.cy - 1.0, v2 = (x(1) * x(2) + sv) / h * K.fy + K.cy + 1.0;
   const auto misses = [&](const Box& b) { return u2 <= b.x1 || b.x2 <= u1 || v2 <= b.y1 || b.y2 <= v1; };
   if (misses(area)) return true;
-  for (const int i : box_of)
+  for (const int i : which)
     if (!misses(observations[static_cast<size_t>(i)].box)) return false;
   return true;
 }
