@@ -249,8 +249,10 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
   };
   const auto start = Clock::now();
   const int threads = std::max(1, static_cast<int>(estimators.size()));
-  // One sample at a time on one thread: nothing is generated past the stopping point.
-  const int batch_capacity = threads == 1 ? 1 : 8 * threads;
+  // One sample at a time on one thread: nothing is generated past the stopping point. On more,
+  // batches large enough that waiting for each costs little next to its work (a sample takes a
+  // few microseconds; 64 per batch on two threads were 7-11% faster than 16 on real frames).
+  const int batch_capacity = threads == 1 ? 1 : 32 * threads;
   std::vector<Slot> batch(static_cast<size_t>(batch_capacity));
   int filled = 0, cursor = 0;
   std::atomic<int> next_slot{0};
