@@ -34,7 +34,7 @@ bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int 
     const Projection p = scorer_.projectObject(c.object, *P, pose);
     if (!p.ok()) return false;
     if (check_overlap &&
-        !scorer_.overlapMayReach(observations_[c.observation], p.ellipse, kRankingIoUVertices, min_overlap))
+        !scorer_.overlapMayReach(static_cast<size_t>(c.observation), p.ellipse, kRankingIoUVertices, min_overlap))
       return false;
     own->objects[k] = c.object;
     own->ellipses[k] = p.ellipse;

@@ -88,10 +88,10 @@ double PoseScorer::overlap(const Observation& o, const Ellipse& projected, int v
                                                     : ellipseIoU(o.ellipse, projected, vertices);
 }
 
-bool PoseScorer::overlapMayReach(const Observation& o, const Ellipse& projected, int vertices, double threshold) const {
+bool PoseScorer::overlapMayReach(size_t i, const Ellipse& projected, int vertices, double threshold) const {
   // The margin absorbs the rounding between the bound and the exact overlap.
   return options_.overlap != OverlapMeasure::EllipseIoU ||
-         ellipseIoUUpperBound(o.ellipse, projected, vertices) >= threshold - 1e-9;
+         ellipseBound(i, projected, projected.boundingBox(), vertices) >= threshold - 1e-9;
 }
 
 bool PoseScorer::overlapCertainlyReaches(const Observation& o, const Ellipse& projected, int vertices,
@@ -116,15 +116,17 @@ void PoseScorer::forEachNearbyPair(F f) const {
   }
 }
 
-double PoseScorer::pairBound(size_t i, int j, int vertices) const {
-  const Observation& o = observations_[i];
-  if (options_.overlap == OverlapMeasure::BoxIoU) return boxIoU(o.box, projected_box_[j]);
-  // ellipseIoUUpperBound(o.ellipse, projected_[j], vertices), from the extents kept (a projection
-  // that succeeded is a valid ellipse).
+double PoseScorer::ellipseBound(size_t i, const Ellipse& projected, const Box& projected_box, int vertices) const {
+  // ellipseIoUUpperBound(observations_[i].ellipse, projected, vertices), from the observation's
+  // extents kept (a projection that succeeded is a valid ellipse).
   if (!observation_valid_[i]) return 0.0;
-  const Ellipse& p = projected_[j];
-  return detail::iouUpperBoundFromExtents(observation_area_[i], o.ellipse.center(), observation_box_[i], p.area(),
-                                          p.center(), projected_box_[j], vertices);
+  return detail::iouUpperBoundFromExtents(observation_area_[i], observations_[i].ellipse.center(), observation_box_[i],
+                                          projected.area(), projected.center(), projected_box, vertices);
+}
+
+double PoseScorer::pairBound(size_t i, int j, int vertices) const {
+  if (options_.overlap == OverlapMeasure::BoxIoU) return boxIoU(observations_[i].box, projected_box_[j]);
+  return ellipseBound(i, projected_[j], projected_box_[j], vertices);
 }
 
 double PoseScorer::costLowerBound(int vertices) {

@@ -34,8 +34,9 @@ class PoseScorer {
 
   /// The overlap of an observation and a projected ellipse under the options' measure.
   double overlap(const Observation& o, const Ellipse& projected, int vertices) const;
-  /// False when the overlap's upper bound already shows that it is below `threshold`.
-  bool overlapMayReach(const Observation& o, const Ellipse& projected, int vertices, double threshold) const;
+  /// False when the upper bound of the overlap of observation i and `projected` (a projection
+  /// that succeeded) already shows that it is below `threshold`.
+  bool overlapMayReach(size_t i, const Ellipse& projected, int vertices, double threshold) const;
   /// False when the image of map object j at `pose` is certainly too large or too small to
   /// overlap observation o by `threshold` under the ellipse IoU, which is at most the ratio of the
   /// two areas (imageAreaBounds: no projection). j must be a candidate of some observation.
@@ -83,6 +84,8 @@ class PoseScorer {
   /// An upper bound of the overlap of observation i and object j's current projection (under
   /// box IoU, the overlap itself): a few operations.
   double pairBound(size_t i, int j, int vertices) const;
+  /// ellipseIoUUpperBound of observation i's ellipse and a successful projection with its box.
+  double ellipseBound(size_t i, const Ellipse& projected, const Box& projected_box, int vertices) const;
   /// unmatched_cost per usable observation less, for each, the most its best projected
   /// candidate could gain by the overlap bound: no exact overlap is computed. Keeps each pair's
   /// bound (pair_bounds_, in forEachNearbyPair's order) for the exact pass.
