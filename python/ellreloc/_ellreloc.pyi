@@ -164,6 +164,7 @@ class FewObjectSolverOptions:
     angle_steps: int
     axis_step_deg: float
     max_poses: int
+    skip_tilted: bool
     refiner: RefinerOptions
 
 

@@ -196,6 +196,7 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("angle_steps", &FewObjectOptions::angle_steps)
       .def_readwrite("axis_step_deg", &FewObjectOptions::axis_step_deg)
       .def_readwrite("max_poses", &FewObjectOptions::max_poses)
+      .def_readwrite("skip_tilted", &FewObjectOptions::skip_tilted)
       .def_readwrite("refiner", &FewObjectOptions::refiner);
   py::class_<FewObjectSearchOptions>(m, "FewObjectOptions")
       .def(py::init<>())
@@ -416,7 +417,8 @@ void bindRefiner(py::module_& m) {
                            "An observed ellipse and the map ellipsoid it shows; sigma is the ellipse's expected "
                            "error in units of its size (1: a box's ellipse), a smaller one weighs more.")
       .def(py::init([](const Ellipse& e, const Ellipsoid& q, double sigma) {
-             if (!(std::isfinite(sigma) && sigma > 0)) throw ellreloc::Error("EllipseMatch: sigma must be a positive number");
+             if (!(std::isfinite(sigma) && sigma > 0))
+               throw ellreloc::Error("EllipseMatch: sigma must be a positive number");
              return EllipseMatch{e, q, sigma};
            }),
            py::arg("observed"), py::arg("ellipsoid"), py::arg("sigma") = 1.0)

@@ -62,6 +62,12 @@ std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Mat
 
 namespace {
 
+/// The gravity term of sweepCost: the squared tilt error in units of the prior's sigma.
+double gravityCost(const GravityPrior& gravity, const Eigen::Matrix3d& R_cw) {
+  const double angle = gravity.errorDeg(Pose(R_cw, Eigen::Vector3d::Zero())) / gravity.sigma_deg;
+  return angle * angle;
+}
+
 /// The refiner's object cost (its robust loss of the normalised W2^2) plus the gravity term: the
 /// sweep ranks angles by what the refinement will minimise. `prepared`: the matches' ellipsoids.
 double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<EllipseMatch>& matches,
@@ -75,10 +81,7 @@ double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<Ellips
     const double s = wasserstein2Squared(m.observed, p.ellipse) / m.observed.axes().prod();
     total += robustLoss(opt.object_loss, opt.object_loss_scale, s);
   }
-  if (gravity) {
-    const double angle = gravity->errorDeg(pose) / gravity->sigma_deg;
-    total += angle * angle;
-  }
+  if (gravity) total += gravityCost(*gravity, pose.rotation());
   return std::isfinite(total) ? total : std::numeric_limits<double>::infinity();
 }
 
@@ -175,14 +178,31 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
     if (c.allFinite()) aligns.push_back(Eigen::Quaterniond::FromTwoVectors(w, c).toRotationMatrix());
   const std::vector<EllipseMatch> matches{a, b};
   const std::vector<ProjectableEllipsoid> prepared = prepare(matches);
+  std::vector<Eigen::Matrix3d> rotations(aligns.size());
+  std::vector<double> tilt_cost(aligns.size(), 0.0);
+  std::vector<size_t> order(aligns.size());
   return sweepAndRefine(K, matches, gravity, options, [&](double angle) -> std::optional<ScoredPose> {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, w).toRotationMatrix();
+    for (size_t i = 0; i < aligns.size(); ++i) {
+      rotations[i] = aligns[i] * turn;
+      if (gravity && options.skip_tilted) tilt_cost[i] = gravityCost(*gravity, rotations[i]);
+    }
+    // The cost of the first of the rotations that cost least. The objects' terms are not
+    // negative, so a rotation's gravity term alone bounds its cost from below: with gravity,
+    // the rotations are tried from the most level one, and one whose tilt already costs more
+    // than the best found is not placed (most of them, the prior being a few degrees wide).
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    if (gravity && options.skip_tilted)
+      std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return tilt_cost[x] < tilt_cost[y]; });
     std::optional<ScoredPose> best;
-    for (const Eigen::Matrix3d& align : aligns) {
-      const std::optional<Pose> pose = placeAll(K, align * turn, matches, prepared);
+    size_t best_index = 0;
+    for (const size_t i : order) {
+      if (best && (tilt_cost[i] > best->cost || (tilt_cost[i] == best->cost && i > best_index))) continue;
+      const std::optional<Pose> pose = placeAll(K, rotations[i], matches, prepared);
       if (!pose) continue;
       const double cost = sweepCost(K, *pose, matches, prepared, gravity, options.refiner);
-      if (!best || cost < best->cost) best = ScoredPose{*pose, cost};
+      if (!best || cost < best->cost || (cost == best->cost && i < best_index))
+        best = ScoredPose{*pose, cost}, best_index = i;
     }
     return best;
   });

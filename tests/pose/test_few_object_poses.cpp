@@ -128,6 +128,40 @@ TEST(FewObjectPoses, OneObjectAndGravityGiveThePose) {
   EXPECT_GE(any, 0.93 * trials);
 }
 
+TEST(FewObjectPoses, SkippingTiltedRotationsKeepsTheTwoObjectPoses) {
+  std::mt19937 rng(7);
+  const Intrinsics K = test::testIntrinsics();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  FewObjectOptions every_rotation;
+  every_rotation.skip_tilted = false;
+  int trials = 0, first = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 2, 1.0, 0.03, &m)) continue;
+    ++trials;
+    // An IMU about a degree off, trusted to 2 degrees, and a loose prior (30 degrees) whose
+    // tilt terms are as large as the objects' terms, so that a wrong skip would show.
+    for (const double sigma_deg : {2.0, 30.0}) {
+      GravityPrior gravity = GravityPrior::atPose(truth, Eigen::Vector3d::UnitZ(), sigma_deg);
+      const Eigen::Vector3d tilt = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)) * (M_PI / 180.0);
+      gravity.up_in_camera = Eigen::AngleAxisd(tilt.norm(), tilt.normalized()) * gravity.up_in_camera;
+      const auto skipping = posesFromTwoObjects(K, m[0], m[1], gravity);
+      const auto all = posesFromTwoObjects(K, m[0], m[1], gravity, every_rotation);
+      ASSERT_EQ(skipping.size(), all.size()) << "trial " << trial << ", sigma " << sigma_deg;
+      for (size_t i = 0; i < all.size(); ++i) {  // to the bit
+        EXPECT_EQ(skipping[i].cost, all[i].cost) << "trial " << trial << ", sigma " << sigma_deg;
+        EXPECT_TRUE(skipping[i].pose.rotation() == all[i].pose.rotation()) << "trial " << trial;
+        EXPECT_TRUE(skipping[i].pose.translation() == all[i].pose.translation()) << "trial " << trial;
+      }
+      if (sigma_deg == 2.0)
+        first += !all.empty() && positionError(all[0].pose, truth) < 0.15 && rotationError(all[0].pose, truth) < 5.0;
+    }
+  }
+  EXPECT_GT(trials, 40);
+  EXPECT_GE(first, 0.65 * trials);  // the floor of TwoNoisyObjects, without gravity
+}
+
 TEST(FewObjectPoses, RefinerWithGravityFixesThePoseFromOneObject) {
   std::mt19937 rng(5);
   const Intrinsics K = test::testIntrinsics();
