@@ -4,7 +4,8 @@
 //   fr3   every 10th frame of the odd frames of the fr3/long_office first half (129) against a map
 //         built from its even frames by the boxes mapper (motion-capture poses)
 // Ours also with each frame's hypotheses split over 2 threads (search.threads), and on fr2 with an
-// upright camera (CameraEnvelope::upright: the map's up is -y, its first keyframe's image-up).
+// upright camera (CameraEnvelope::upright: the map's up is -y, its first keyframe's image-up) or
+// with an IMU's gravity (GravityPrior at each keyframe's pose, about the keyframes' mean image-up).
 // Run: ./build/benchmarks/bench_real_frames --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -32,6 +33,7 @@ struct RealSet {
   Intrinsics K;
   ObjectMap map;
   std::vector<std::vector<Observation>> frames;
+  std::vector<GravityPrior> gravity;  ///< fr2: what an IMU would measure at each frame's pose
 };
 
 RealSet fr2() {
@@ -39,8 +41,16 @@ RealSet fr2() {
   const std::string d = kData + "/tum_fr2_desk";
   s.K = io::readCamera(d + "/camera.yaml");
   s.map = io::readMap(d + "/map.json");
-  for (const DetectionFrame& f : io::readDetections(d + "/keyframes.detections.json"))
+  const std::vector<io::StampedPose> poses = io::readTumTrajectory(d + "/keyframes.groundtruth.txt");
+  const std::vector<DetectionFrame> frames = io::readDetections(d + "/keyframes.detections.json");
+  // The map is in its first camera's frame: gravity is about the keyframes' mean image-up (-y).
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const io::StampedPose& p : poses) up -= p.pose.rotation().row(1).transpose();
+  for (const DetectionFrame& f : frames) {
     s.frames.push_back(observeDetections(f.detections, s.K.width, s.K.height));
+    const Pose* pose = io::framePose(poses, f);
+    s.gravity.push_back(pose ? GravityPrior::atPose(*pose, up.normalized(), 1.0) : GravityPrior{});
+  }
   return s;
 }
 
@@ -80,9 +90,9 @@ double percentile(std::vector<double> v, double p) {
 /// One frame per iteration, every frame once per repetition; the counters give the median and
 /// the 90th percentile of the frames' times. state.range(0): the OA-SLAM preset; range(1): the
 /// threads that split each frame's hypotheses (search.threads). `up`: the map's up, for a camera
-/// that is never upside down.
+/// that is never upside down; `with_gravity`: each frame with its set's gravity prior.
 void relocalizeEveryFrame(benchmark::State& state, const RealSet& set,
-                          const std::optional<Eigen::Vector3d>& up = std::nullopt) {
+                          const std::optional<Eigen::Vector3d>& up = std::nullopt, bool with_gravity = false) {
   RelocalizerOptions options = state.range(0) ? RelocalizerOptions::oaSlam() : RelocalizerOptions();
   options.search.threads = static_cast<int>(state.range(1));
   if (up) options.envelope = CameraEnvelope::upright(*up);
@@ -91,7 +101,10 @@ void relocalizeEveryFrame(benchmark::State& state, const RealSet& set,
   size_t i = 0;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(reloc.relocalize(set.frames[i]));
+    if (with_gravity)
+      benchmark::DoNotOptimize(reloc.relocalize(set.frames[i], {}, set.gravity[i]));
+    else
+      benchmark::DoNotOptimize(reloc.relocalize(set.frames[i]));
     times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     i = (i + 1) % set.frames.size();
   }
@@ -109,6 +122,13 @@ BENCHMARK(BM_Fr2Keyframes)
     ->Args({0, 2, 0})
     ->Args({1, 1, 0})
     ->Args({0, 1, 1})
+    ->Iterations(198)
+    ->Unit(benchmark::kMillisecond);
+
+void BM_Fr2KeyframesGravity(benchmark::State& state) { relocalizeEveryFrame(state, realSet(0), std::nullopt, true); }
+BENCHMARK(BM_Fr2KeyframesGravity)
+    ->ArgNames({"oaslam", "threads"})
+    ->Args({0, 1})
     ->Iterations(198)
     ->Unit(benchmark::kMillisecond);
 
