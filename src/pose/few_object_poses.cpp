@@ -11,23 +11,36 @@ namespace ellreloc {
 
 namespace {
 
-/// project() for an ellipsoid prepared once and a rotation that is one by construction (the
-/// sweep's come from axis-angles and quaternions; placeObject checks a caller's): the same
-/// result without building the ellipsoid's matrices and checking the rotation at every step.
-Projection projectAt(const ProjectableEllipsoid& e, const Intrinsics& K, const Pose& pose) {
-  if (!pose.translation().allFinite()) return Projection{};
-  return projectPrepared(e, projectionMatrix(K, pose), pose);
+/// The image of an ellipsoid given in the camera frame: centre x, shape matrix M = R diag(a^2)
+/// R^T turned into the camera. Its dual conic is K (M - x x^T) K^T (P Q* P^T for P = K [R | t],
+/// written without the world), an ellipse when the ellipsoid lies strictly in front of the
+/// principal plane (x_z > 0 and M_zz < x_z^2, as projectPrepared tells it). The sweeps place
+/// each object at many depths for one rotation: M is computed once for all of them.
+std::optional<Ellipse> imageInCameraFrame(const Eigen::Matrix3d& M, const Eigen::Vector3d& x, const Intrinsics& K) {
+  if (!x.allFinite()) return std::nullopt;
+  const Eigen::Matrix3d N = M - x * x.transpose();
+  if (!(x(2) > 0.0 && N(2, 2) < 0.0)) return std::nullopt;
+  // K N K^T with K's zeros skipped.
+  const double u = K.fx * N(0, 2) + K.cx * N(2, 2), v = K.fy * N(1, 2) + K.cy * N(2, 2);
+  Eigen::Matrix3d C;
+  C(0, 0) = K.fx * (K.fx * N(0, 0) + K.cx * N(0, 2)) + K.cx * u;
+  C(1, 1) = K.fy * (K.fy * N(1, 1) + K.cy * N(1, 2)) + K.cy * v;
+  C(0, 1) = C(1, 0) = K.fx * (K.fy * N(0, 1) + K.cy * N(0, 2)) + K.cx * v;
+  C(0, 2) = C(2, 0) = u;
+  C(1, 2) = C(2, 1) = v;
+  C(2, 2) = N(2, 2);
+  return Ellipse::fromDualConic(C);
 }
 
-/// placeObject for a prepared, valid ellipsoid and a rotation.
+/// placeObject for a prepared, valid ellipsoid and a rotation; `M`: its shape matrix in the
+/// camera, R_cw prepared.shape R_cw^T.
 std::optional<Eigen::Vector3d> placePrepared(const Intrinsics& K, const Eigen::Matrix3d& R_cw, const Ellipse& observed,
-                                             const ProjectableEllipsoid& prepared) {
+                                             const ProjectableEllipsoid& prepared, const Eigen::Matrix3d& M) {
   const Ellipsoid& e = prepared.ellipsoid;
   const double observed_size = std::sqrt(observed.axes().prod());
   Eigen::Vector3d bearing = K.bearing(observed.center());
   // First depth from the silhouette seen along the bearing (orthographic): its radius
   // det(S)^(1/4), S the camera-frame shape matrix restricted to the plane across the bearing.
-  const Eigen::Matrix3d M = R_cw * prepared.shape * R_cw.transpose();
   const Eigen::Vector3d u = bearing.unitOrthogonal(), v = bearing.cross(u);
   Eigen::Matrix2d S;
   S << u.dot(M * u), u.dot(M * v), v.dot(M * u), v.dot(M * v);
@@ -36,20 +49,24 @@ std::optional<Eigen::Vector3d> placePrepared(const Intrinsics& K, const Eigen::M
   depth = std::max(depth, 1.01 * e.axes().maxCoeff());  // the camera stays outside
   // Perspective: the image size goes as 1 / depth near the answer, and the centre of the
   // projected ellipse is not the projection of the centre; a few fixed-point steps fix both.
+  // The ellipsoid's centre is at depth x bearing in the camera.
   for (int iteration = 0; iteration < 4; ++iteration) {
-    const Pose pose(R_cw, depth * bearing - R_cw * e.center());
-    const Projection p = projectAt(prepared, K, pose);
-    if (!p) {
+    const std::optional<Ellipse> image = imageInCameraFrame(M, depth * bearing, K);
+    if (!image) {
       depth *= 2.0;  // too close: the ellipsoid reaches behind the principal plane
       continue;
     }
-    const Eigen::Vector2d offset = p.ellipse.center() - K.project(depth * bearing);
-    depth *= std::sqrt(p.ellipse.axes().prod()) / observed_size;
+    const Eigen::Vector2d offset = image->center() - K.project(depth * bearing);
+    depth *= std::sqrt(image->axes().prod()) / observed_size;
     bearing = K.bearing(observed.center() - offset);
   }
   const Eigen::Vector3d t = depth * bearing - R_cw * e.center();
-  if (!t.allFinite() || !projectAt(prepared, K, Pose(R_cw, t))) return std::nullopt;
+  if (!t.allFinite() || !imageInCameraFrame(M, depth * bearing, K)) return std::nullopt;
   return t;
+}
+
+Eigen::Matrix3d shapeInCamera(const Eigen::Matrix3d& R_cw, const ProjectableEllipsoid& prepared) {
+  return R_cw * prepared.shape * R_cw.transpose();
 }
 
 }  // namespace
@@ -57,7 +74,8 @@ std::optional<Eigen::Vector3d> placePrepared(const Intrinsics& K, const Eigen::M
 std::optional<Eigen::Vector3d> placeObject(const Intrinsics& K, const Eigen::Matrix3d& R_cw,
                                            const EllipseMatch& match) {
   if (!K.isValid() || !match.observed.isValid() || !match.ellipsoid.isValid() || !isRotation(R_cw)) return std::nullopt;
-  return placePrepared(K, R_cw, match.observed, ProjectableEllipsoid(match.ellipsoid));
+  const ProjectableEllipsoid prepared(match.ellipsoid);
+  return placePrepared(K, R_cw, match.observed, prepared, shapeInCamera(R_cw, prepared));
 }
 
 namespace {
@@ -69,16 +87,18 @@ double gravityCost(const GravityPrior& gravity, const Eigen::Matrix3d& R_cw) {
 }
 
 /// The refiner's object cost (its robust loss of the normalised W2^2) plus the gravity term: the
-/// sweep ranks angles by what the refinement will minimise. `prepared`: the matches' ellipsoids.
+/// sweep ranks angles by what the refinement will minimise. `prepared`: the matches' ellipsoids,
+/// `shapes`: their shape matrices in the camera at this pose's rotation.
 double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<EllipseMatch>& matches,
-                 const std::vector<ProjectableEllipsoid>& prepared, const std::optional<GravityPrior>& gravity,
-                 const RefinerOptions& opt) {
+                 const std::vector<ProjectableEllipsoid>& prepared, const std::vector<Eigen::Matrix3d>& shapes,
+                 const std::optional<GravityPrior>& gravity, const RefinerOptions& opt) {
   double total = 0.0;
   for (size_t i = 0; i < matches.size(); ++i) {
     const EllipseMatch& m = matches[i];
-    const Projection p = projectAt(prepared[i], K, pose);
-    if (!p) return std::numeric_limits<double>::infinity();
-    const double s = wasserstein2Squared(m.observed, p.ellipse) / m.observed.axes().prod();
+    const std::optional<Ellipse> image =
+        imageInCameraFrame(shapes[i], pose.transform(prepared[i].ellipsoid.center()), K);
+    if (!image) return std::numeric_limits<double>::infinity();
+    const double s = wasserstein2Squared(m.observed, *image) / m.observed.axes().prod();
     total += robustLoss(opt.object_loss, opt.object_loss_scale, s);
   }
   if (gravity) total += gravityCost(*gravity, pose.rotation());
@@ -86,11 +106,14 @@ double sweepCost(const Intrinsics& K, const Pose& pose, const std::vector<Ellips
 }
 
 /// Places every object at rotation R_cw; the translation is the mean of their placements.
+/// `shapes` receives the objects' shape matrices in the camera.
 std::optional<Pose> placeAll(const Intrinsics& K, const Eigen::Matrix3d& R_cw, const std::vector<EllipseMatch>& matches,
-                             const std::vector<ProjectableEllipsoid>& prepared) {
+                             const std::vector<ProjectableEllipsoid>& prepared, std::vector<Eigen::Matrix3d>* shapes) {
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  shapes->resize(matches.size());
   for (size_t i = 0; i < matches.size(); ++i) {
-    const auto ti = placePrepared(K, R_cw, matches[i].observed, prepared[i]);
+    (*shapes)[i] = shapeInCamera(R_cw, prepared[i]);
+    const auto ti = placePrepared(K, R_cw, matches[i].observed, prepared[i], (*shapes)[i]);
     if (!ti) return std::nullopt;
     t += *ti / static_cast<double>(matches.size());
   }
@@ -181,6 +204,7 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
   std::vector<Eigen::Matrix3d> rotations(aligns.size());
   std::vector<double> tilt_cost(aligns.size(), 0.0);
   std::vector<size_t> order(aligns.size());
+  std::vector<Eigen::Matrix3d> shapes;
   return sweepAndRefine(K, matches, gravity, options, [&](double angle) -> std::optional<ScoredPose> {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, w).toRotationMatrix();
     for (size_t i = 0; i < aligns.size(); ++i) {
@@ -198,9 +222,9 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
     size_t best_index = 0;
     for (const size_t i : order) {
       if (best && (tilt_cost[i] > best->cost || (tilt_cost[i] == best->cost && i > best_index))) continue;
-      const std::optional<Pose> pose = placeAll(K, rotations[i], matches, prepared);
+      const std::optional<Pose> pose = placeAll(K, rotations[i], matches, prepared, &shapes);
       if (!pose) continue;
-      const double cost = sweepCost(K, *pose, matches, prepared, gravity, options.refiner);
+      const double cost = sweepCost(K, *pose, matches, prepared, shapes, gravity, options.refiner);
       if (!best || cost < best->cost || (cost == best->cost && i < best_index))
         best = ScoredPose{*pose, cost}, best_index = i;
     }
@@ -217,11 +241,12 @@ std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMat
       Eigen::Quaterniond::FromTwoVectors(up, gravity.up_in_camera.normalized()).toRotationMatrix();
   const std::vector<EllipseMatch> matches{a};
   const std::vector<ProjectableEllipsoid> prepared = prepare(matches);
+  std::vector<Eigen::Matrix3d> shapes;
   return sweepAndRefine(K, matches, gravity, options, [&](double yaw) -> std::optional<ScoredPose> {
     const std::optional<Pose> pose =
-        placeAll(K, align * Eigen::AngleAxisd(yaw, up).toRotationMatrix(), matches, prepared);
+        placeAll(K, align * Eigen::AngleAxisd(yaw, up).toRotationMatrix(), matches, prepared, &shapes);
     if (!pose) return std::nullopt;
-    return ScoredPose{*pose, sweepCost(K, *pose, matches, prepared, gravity, options.refiner)};
+    return ScoredPose{*pose, sweepCost(K, *pose, matches, prepared, shapes, gravity, options.refiner)};
   });
 }
 
