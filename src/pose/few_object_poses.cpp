@@ -65,6 +65,7 @@ std::optional<Eigen::Vector3d> placePrepared(const Intrinsics& K, const Eigen::M
   return t;
 }
 
+/// An ellipsoid's shape matrix turned into the camera of rotation R_cw: R_cw M R_cw^T.
 Eigen::Matrix3d shapeInCamera(const Eigen::Matrix3d& R_cw, const ProjectableEllipsoid& prepared) {
   return R_cw * prepared.shape * R_cw.transpose();
 }
