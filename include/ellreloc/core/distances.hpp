@@ -129,8 +129,9 @@ struct DiscAndPolygon {
   const Ellipse& disc;
   const Ellipse& polygon;
 };
+inline bool firstIsPolygon(double area1, double area2) { return area1 < area2; }
 inline DiscAndPolygon discAndPolygon(const Ellipse& e1, const Ellipse& e2, double area1, double area2) {
-  return area1 < area2 ? DiscAndPolygon{e2, e1} : DiscAndPolygon{e1, e2};
+  return firstIsPolygon(area1, area2) ? DiscAndPolygon{e2, e1} : DiscAndPolygon{e1, e2};
 }
 
 /// x' = diag(1/a, 1/b) R^T (x - c) maps `e` onto the unit disc: this is its linear part.
@@ -266,7 +267,7 @@ namespace detail {
 inline double iouUpperBoundFromExtents(double area1, const Eigen::Vector2d& centre1, const Box& box1, double area2,
                                        const Eigen::Vector2d& centre2, const Box& box2, int vertices) {
   if (!std::isfinite(area1 + area2)) return 1.0;  // areas beyond a double: no bound
-  const bool first_is_polygon = area1 < area2;    // discAndPolygon's choice
+  const bool first_is_polygon = firstIsPolygon(area1, area2);
   const Box& s = first_is_polygon ? box1 : box2;
   const Box& b = first_is_polygon ? box2 : box1;
   const Eigen::Vector2d& c = first_is_polygon ? centre1 : centre2;
