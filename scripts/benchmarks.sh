@@ -70,6 +70,7 @@ if [ -d "$build/python/ellreloc" ] && [ -n "$python" ]; then
 else
   echo "benchmarks: python_overhead and regular_verdict skipped (no Python bindings in $build)" >&2
 fi
+table startup python3 benchmarks/startup.py "$build" "$data" "$python"
 
 scripts/doc_images.sh "$build"
 

@@ -1,20 +1,20 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target (ASan + UBSan, any report aborts) for SECONDS (default 30) from the
 # seed corpus in tests/fuzz/corpus. The targets come from the sanitizer build of
-# scripts/sanitize.sh asan (built here if missing). The corpus grown during the run stays in
+# scripts/sanitize.sh asan (configured here if missing, built or brought up to date). The corpus
+# grown during the run stays in
 # build-asan/corpus/; crashing inputs go to build-asan/artifacts/.
 #   scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 dir=build-asan
-if [ ! -x "$dir/tests/fuzz/fuzz_rle" ]; then
-  scripts/sanitize.sh configure-asan
-  cmake --build "$dir" -j "$(nproc)" --target fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer
-fi
+targets=(fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer fuzz_image)
+[ -f "$dir/build.ninja" ] || scripts/sanitize.sh configure-asan
+cmake --build "$dir" -j "$(nproc)" --target "${targets[@]}"  # nothing to do when they are up to date
 mkdir -p "$dir/artifacts"
 status=0
-for target in fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer; do
+for target in "${targets[@]}"; do
   mkdir -p "$dir/corpus/$target"
   log="$dir/$target.log"
   if "$dir/tests/fuzz/$target" "$dir/corpus/$target" "tests/fuzz/corpus/$target" \

@@ -4,7 +4,7 @@ set -euo pipefail
 
 packages=(
   cmake ninja-build g++ pkg-config
-  libeigen3-dev libceres-dev libopencv-dev nlohmann-json3-dev libcli11-dev
+  libeigen3-dev libceres-dev libopencv-dev libpng-dev libjpeg-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopengv-dev  # benchmarks only: P3P comparison with OpenGV's Kneip solver
   clang-14 libclang-rt-14-dev  # reliability only: sanitizer builds and libFuzzer (scripts/sanitize.sh, fuzz.sh)

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "ellreloc/error.hpp"
+#include "ellreloc/io/image_codec.hpp"
 
 namespace ellreloc::cli {
 
@@ -181,9 +181,7 @@ std::string Figure::png() const {
       drawText(img, t->text, t->at, t->size, t->anchor, t->colour, t->vertical);
     }
   }
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", img, bytes, {cv::IMWRITE_PNG_COMPRESSION, 9})) throw Error("could not encode a PNG figure");
-  return std::string(bytes.begin(), bytes.end());
+  return io::encodePng(img.data, img.cols, img.rows, io::PixelFormat::Bgr8, img.step, 9);
 }
 
 // --- Axes -------------------------------------------------------------------------------------

@@ -2,12 +2,12 @@
 
 #include <cstdio>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
+#include "ellreloc/io/image_codec.hpp"
 
 namespace ellreloc::io {
 
@@ -44,13 +44,13 @@ std::vector<std::optional<Ellipse>> projectMap(const ObjectMap& map, const Intri
 cv::Mat canvas(const Intrinsics& K, const std::string& background) {
   if (background.empty()) return cv::Mat(K.height, K.width, CV_8UC3, cv::Scalar(245, 245, 245));
   const std::string bytes = readTextFile(background);
-  cv::Mat img = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
-                             cv::IMREAD_COLOR);
-  if (img.empty()) throw Error(background + ": not an image OpenCV can read");
+  DecodedImage decoded = decodeImage(bytes, background, DecodeAs::Bgr8);
+  cv::Mat img(decoded.height, decoded.width, CV_8UC3, decoded.pixels.data());
   if (img.cols != K.width || img.rows != K.height) cv::resize(img, img, cv::Size(K.width, K.height));
-  // Lighter, so that the drawing stands out.
-  img.convertTo(img, -1, 0.6, 90);
-  return img;
+  // Lighter, so that the drawing stands out (into a new matrix: `img` may view `decoded`).
+  cv::Mat lighter;
+  img.convertTo(lighter, -1, 0.6, 90);
+  return lighter;
 }
 
 }  // namespace
@@ -94,10 +94,7 @@ void writeOverlay(const std::string& path, const Intrinsics& K, const ObjectMap&
                                        "matches"
                                      : "green: detections  orange: map at the pose  magenta: matches";
   label(img, legend, cv::Point(8, K.height - 8), cv::Scalar(60, 60, 60), 0.4);
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", img, png, {cv::IMWRITE_PNG_COMPRESSION, 6}))
-    throw Error(path + ": could not encode the overlay as PNG");
-  writeFileAtomically(path, std::string(png.begin(), png.end()));
+  writeFileAtomically(path, encodePng(img.data, img.cols, img.rows, PixelFormat::Bgr8, img.step, 6));
 }
 
 }  // namespace ellreloc::io

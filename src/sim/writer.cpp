@@ -3,13 +3,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/files.hpp"
+#include "ellreloc/io/image_codec.hpp"
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/io/rgbd.hpp"
 #include "ellreloc/io/trajectory.hpp"
@@ -41,9 +41,7 @@ void writeRgb(const std::string& path, const RenderedFrame& f) {
       img.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uint8_t>(c[0] * shade), static_cast<uint8_t>(c[1] * shade),
                                           static_cast<uint8_t>(c[2] * shade));
     }
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", img, png)) throw Error(path + ": PNG encoding failed");
-  io::writeFileAtomically(path, std::string(png.begin(), png.end()));
+  io::writeFileAtomically(path, io::encodePng(img.data, img.cols, img.rows, io::PixelFormat::Bgr8, img.step));
 }
 
 void makeDirs(const std::string& dir) {
