@@ -8,6 +8,7 @@
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/files.hpp"
+#include "ellreloc/io/image_codec.hpp"
 #include "ellreloc/io/map.hpp"
 #include "ellreloc/io/overlay.hpp"
 #include "ellreloc/io/rgbd.hpp"
