@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
 
@@ -98,6 +101,54 @@ TEST_F(Pictures, OverlaysDrawTheMapWhereTheReturnedPoseProjectsIt) {
   for (int y = 0; y < K.height; y += 8)
     for (int x = 0; x < K.width; x += 8) differing += on_image.at<cv::Vec3b>(y, x) != blank.at<cv::Vec3b>(y, x);
   EXPECT_GT(differing, K.width * K.height / 64 / 4);  // the rendered image shows through
+}
+
+TEST_F(Pictures, OverlaysTakeJpegBackgroundsAndNameAnUnreadableOne) {
+  test::TempDir dir;
+  std::ifstream in(scene_ + "/query/detections.json");
+  const std::string detections((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::smatch first;
+  ASSERT_TRUE(std::regex_search(detections, first, std::regex("rgb/([0-9.]+)\\.png")));
+  const std::string stamp = first[1];
+  // The first frame's image as a JPEG beside a copy of the detections that names it.
+  fs::create_directories(dir.path("jpeg/rgb"));
+  const cv::Mat image = cv::imread(scene_ + "/query/rgb/" + stamp + ".png");
+  ASSERT_FALSE(image.empty());
+  ASSERT_TRUE(cv::imwrite(dir.path("jpeg/rgb/" + stamp + ".jpg"), image, {cv::IMWRITE_JPEG_QUALITY, 95}));
+  const std::string as_jpeg =
+      std::regex_replace(detections, std::regex("rgb/" + stamp + "\\.png"), "rgb/" + stamp + ".jpg");
+  std::ofstream(dir.path("jpeg/detections.json")) << as_jpeg;
+  CliRun r = run(relocalizeArgs(scene_ + "/query/detections.json") + " --out " + dir.path("a.txt") + " --overlays " +
+                     dir.path("png_overlays"),
+                 dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run(relocalizeArgs(dir.path("jpeg/detections.json")) + " --out " + dir.path("b.txt") + " --overlays " +
+              dir.path("jpeg_overlays"),
+          dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const cv::Mat over_png = cv::imread(dir.path("png_overlays/" + stamp + ".png"));
+  const cv::Mat over_jpeg = cv::imread(dir.path("jpeg_overlays/" + stamp + ".png"));
+  ASSERT_FALSE(over_png.empty());
+  ASSERT_EQ(over_png.size(), over_jpeg.size());
+  // The same picture up to the JPEG's error (lightened to 0.6 of it by the overlay): a few
+  // pixels at colour edges are far off (chroma subsampling: 0.3% here), where colour channels
+  // read in the wrong order put 2% of them so, every object's pixels.
+  cv::Mat off;
+  cv::absdiff(over_png, over_jpeg, off);
+  off = off.reshape(1, static_cast<int>(off.total()));
+  cv::reduce(off, off, 1, cv::REDUCE_MAX);
+  EXPECT_LT(cv::countNonZero(off > 24) / static_cast<double>(off.total()), 0.01);
+  // A background that is no image: one line naming the file, no overlay for it.
+  fs::create_directories(dir.path("bad/rgb"));
+  std::ofstream(dir.path("bad/rgb/" + stamp + ".png")) << "not an image";
+  std::ofstream(dir.path("bad/detections.json")) << detections;
+  r = run(relocalizeArgs(dir.path("bad/detections.json")) + " --out " + dir.path("c.txt") + " --overlays " +
+              dir.path("bad_overlays"),
+          dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("rgb/" + stamp + ".png: not a PNG or JPEG image"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir.path("bad_overlays/" + stamp + ".png")));
 }
 
 TEST_F(Pictures, ComparisonPlotsAndPerFrameCsvCoverEveryMethodAndFrame) {

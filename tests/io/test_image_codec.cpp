@@ -32,7 +32,9 @@ cv::Mat opencvDecode(const std::string& bytes, int flags) {
 }
 
 cv::Mat asMat(const io::DecodedImage& d) {
-  const int type = d.format == io::PixelFormat::Grey8 ? CV_8UC1 : d.format == io::PixelFormat::Bgr8 ? CV_8UC3 : CV_16UC1;
+  const int type = d.format == io::PixelFormat::Grey8  ? CV_8UC1
+                   : d.format == io::PixelFormat::Bgr8 ? CV_8UC3
+                                                       : CV_16UC1;
   return cv::Mat(d.height, d.width, type, const_cast<uint8_t*>(d.pixels.data())).clone();
 }
 
