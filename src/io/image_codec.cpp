@@ -69,11 +69,13 @@ void pngRead(png_structp png, png_bytep data, size_t length) {
 
 void pngWrite(png_structp png, png_bytep data, size_t length) {
   auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
+  bool appended = true;
   try {
     io->out->append(reinterpret_cast<const char*>(data), length);
   } catch (...) {
-    png_error(png, "out of memory");
+    appended = false;  // no longjmp out of a handler: it would skip the end of the catch
   }
+  if (!appended) png_error(png, "out of memory");
 }
 
 void pngFlush(png_structp) {}
