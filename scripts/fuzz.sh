@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target (ASan + UBSan, any report aborts) for SECONDS (default 30) from the
 # seed corpus in tests/fuzz/corpus. The targets come from the sanitizer build of
-# scripts/sanitize.sh asan (configured here if missing, built or brought up to date). The corpus
-# grown during the run stays in
-# build-asan/corpus/; crashing inputs go to build-asan/artifacts/.
+# scripts/sanitize.sh asan (configured here if missing, built or brought up to date). The
+# corpus grown during the run stays in build-asan/corpus/; crashing inputs go to
+# build-asan/artifacts/.
 #   scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
