@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   Console console;
   app.add_flag("-q,--quiet", console.quiet, "print nothing but results and errors");
   app.footer("Run `ellreloc SUBCOMMAND --help` for a subcommand's options and an example.");
+  app.set_version_flag("--version", "ellreloc " ELLRELOC_VERSION, "print the version and exit");
 
   SimulateArgs sim;
   ObserveArgs obs;
@@ -37,6 +38,8 @@ int main(int argc, char** argv) {
     return app.exit(h);
   } catch (const CLI::CallForAllHelp& h) {
     return app.exit(h);
+  } catch (const CLI::CallForVersion& v) {
+    return app.exit(v);
   } catch (const CLI::ParseError& err) {
     if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty())
       std::fprintf(stderr, "ellreloc: unknown subcommand '%s' (see --help)\n", argv[1]);

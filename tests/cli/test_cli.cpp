@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <utility>
 
@@ -126,6 +127,9 @@ TEST(Cli, EverySubcommandOnASmallSimulatedScene) {
   EXPECT_GT(fs::file_size(dir.path("gravity.txt")), 0u);
   r = run("--help", dir);
   EXPECT_EQ(r.code, 0);
+  r = run("--version", dir);
+  EXPECT_EQ(r.code, 0);
+  EXPECT_TRUE(std::regex_match(r.out, std::regex("ellreloc [0-9]+\\.[0-9]+\\.[0-9]+\n"))) << r.out;
   for (const std::string sub : {"simulate", "observe", "map", "relocalize", "evaluate", "report", "demo"}) {
     r = run(sub + " --help", dir);
     EXPECT_EQ(r.code, 0) << sub;
