@@ -81,16 +81,11 @@ void pngWrite(png_structp png, png_bytep data, size_t length) {
 void pngFlush(png_structp) {}
 
 /// Reads the image into `out`; false (with io.message set) on any error.
-bool readPng(png_structp png, png_infop info, PngIo& io, DecodeAs as, uint64_t max_pixels, DecodedImage& out,
-             std::vector<png_bytep>& rows) {
+bool readPng(png_structp png, png_infop info, PngIo& io, DecodeAs as, DecodedImage& out, std::vector<png_bytep>& rows) {
   if (setjmp(png_jmpbuf(png))) return false;
   png_set_read_fn(png, &io, pngRead);
-  png_read_info(png, info);
+  png_read_info(png, info);  // the size was checked from these very IHDR bytes (refuseTooLargePng)
   const uint64_t width = png_get_image_width(png, info), height = png_get_image_height(png, info);
-  if (width * height > max_pixels) {
-    std::snprintf(io.message, sizeof io.message, "%s", tooLarge(width, height, max_pixels).c_str());
-    return false;
-  }
   const int colour = png_get_color_type(png, info);
   const int bits = png_get_bit_depth(png, info);
   const bool grey = (colour & PNG_COLOR_MASK_COLOR) == 0;
@@ -146,7 +141,7 @@ DecodedImage decodePng(const std::string& bytes, const std::string& name, Decode
   if (!reader.png || !reader.info) throw Error(name + ": out of memory decoding a PNG image");
   DecodedImage out;
   std::vector<png_bytep> rows;
-  if (!readPng(reader.png, reader.info, io, as, max_pixels, out, rows))
+  if (!readPng(reader.png, reader.info, io, as, out, rows))
     throw Error(name + ": cannot decode PNG image (" + io.message + ")");
   return out;
 }

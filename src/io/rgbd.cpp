@@ -42,9 +42,8 @@ std::vector<Association> readAssociations(const std::string& path) {
 
 DepthImage readDepthPng(const std::string& path, double units_per_metre) {
   const std::string bytes = readTextFile(path);  // names the file when it is missing or unreadable
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kSignature, 8) != 0) throw Error(path + ": not a PNG image");
-  // The decoder refuses an image declaring more than kMaxDepthPixels before decoding it.
+  // The decoder refuses an image declaring more than kMaxDepthPixels before decoding it, and
+  // anything but a PNG or a JPEG; a JPEG, never 16-bit, fails the check below.
   const DecodedImage img = decodeImage(bytes, path, DecodeAs::Stored, kMaxDepthPixels);
   if (img.format != PixelFormat::Grey16) throw Error(path + ": expected a 16-bit single-channel depth PNG");
   DepthImage d;
