@@ -340,6 +340,11 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "solid" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
+  if (const auto& up = relocalizer.upFromObjects(); up && !console.quiet)
+    std::printf(
+        "%s has no camera envelope: the camera is kept upright about the up its objects tell, (%.3f, %.3f, "
+        "%.3f) (t = %.1f over %d objects; --no-map-envelope: anywhere)\n",
+        a.map.c_str(), up->up.x(), up->up.y(), up->up.z(), up->t, up->objects);
   std::optional<GravityPrior> gravity;
   if (a.camera_up.size() == 3 && a.map_up.size() == 3) {
     gravity = GravityPrior{

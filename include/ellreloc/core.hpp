@@ -13,6 +13,7 @@
 #include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/ellipsoid.hpp"
+#include "ellreloc/core/map_up.hpp"
 #include "ellreloc/core/mask.hpp"
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/core/observation.hpp"

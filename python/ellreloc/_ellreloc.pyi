@@ -341,6 +341,7 @@ class ObjectRelocalizer:
     policy: ObservationPolicy
     method: str
     left_out: list[str]
+    up_from_objects: Optional[dict[str, Any]]
 
 
 class Observation:
@@ -688,6 +689,8 @@ VALID_ROTATION_DEG: float
 def bhattacharyya(a: Ellipse, b: Ellipse) -> float: """Bhattacharyya distance between the ellipses' Gaussians."""
 
 def box_iou(a: Box, b: Box) -> float: """Intersection over union of two boxes (0 for invalid ones)."""
+
+def estimate_map_up(map: ObjectMap, min_t: float = ...) -> Optional[dict[str, Any]]: """Which way is up in a map from its objects alone: the direction of least spread of their centres, signed by the usual heights of their categories; a dict (up, t, objects) when the evidence is clear, else None."""
 
 def find_nearest(poses: Sequence[StampedPose | tuple[float | str, Pose]], timestamp: float, tolerance: float = ...) -> Optional[int]: """Index of the pose nearest in time, if within `tolerance` seconds, else None."""
 

@@ -132,6 +132,12 @@ std::vector<RelocalizationResult> relocalizeMany(const Relocalizer& r, const std
   return results;
 }
 
+/// A MapUp as a dict (up, t, objects), or None.
+py::object mapUpToPython(const std::optional<MapUp>& up) {
+  if (!up) return py::none();
+  return py::dict(py::arg("up") = toArray(up->up), py::arg("t") = up->t, py::arg("objects") = up->objects);
+}
+
 bool hasPose(const RelocalizationResult& r) {
   return r.status == RelocalizationStatus::Success || r.status == RelocalizationStatus::LowEvidence;
 }
@@ -409,7 +415,16 @@ void bindRelocalizer(py::module_& m) {
       .def_property_readonly("method", [](const Relocalizer& r) { return r.method; })
       .def_property_readonly(
           "left_out", [](const Relocalizer& r) { return r.relocalizer.leftOut(); },
-          "'object ID: why' for each map object that is never matched.");
+          "'object ID: why' for each map object that is never matched.")
+      .def_property_readonly(
+          "up_from_objects", [](const Relocalizer& r) { return mapUpToPython(r.relocalizer.upFromObjects()); },
+          "The map's up its objects tell (as estimate_map_up) when the camera is kept upright about it: a map "
+          "without a camera_envelope, map_envelope on and no envelope given; else None.");
+  m.def(
+      "estimate_map_up", [](const ObjectMap& map, double min_t) { return mapUpToPython(estimateMapUp(map, min_t)); },
+      py::arg("map"), py::arg("min_t") = 2.5,
+      "Which way is up in a map from its objects alone: the direction of least spread of their centres, signed "
+      "by the usual heights of their categories; a dict (up, t, objects) when the evidence is clear, else None.");
 }
 
 void bindRefiner(py::module_& m) {

@@ -159,7 +159,21 @@ def test_results_and_envelope(fr2, data_dir):
     budget.max_hypotheses = 0
     none = E.ObjectRelocalizer(map_, camera, search={"budget": budget}).relocalize(frames[0])
     assert none.status == E.RelocalizationStatus.no_consistent_hypothesis and none.reason
-    assert E.ObjectRelocalizer(map_, camera, envelope=None).options.envelope is None
+    # The fr2 map has no camera envelope: its objects tell its up, which the relocalizer keeps the
+    # camera upright about. Independently: the up most orthogonal to the keyframes' image-right axes.
+    rights = np.array([p.pose.T_wc[:3, 0] for p in truth])
+    vertical = np.linalg.eigh(rights.T @ rights)[1][:, 0]
+    vertical *= np.sign(vertical @ envelope.up)
+    found = E.estimate_map_up(map_)
+    assert found["objects"] == 45 and found["t"] >= 2.5 and found["up"] @ vertical > math.cos(math.radians(10))
+    assert E.estimate_map_up(map_, min_t=10) is None
+    upright_by_objects = E.ObjectRelocalizer(map_, camera, envelope=None)
+    assert upright_by_objects.up_from_objects["up"].tolist() == found["up"].tolist()
+    assert upright_by_objects.options.envelope.max_tilt_deg == 90
+    np.testing.assert_allclose(upright_by_objects.options.envelope.up, found["up"])
+    anywhere = E.ObjectRelocalizer(map_, camera, map_envelope=False)
+    assert anywhere.options.envelope is None and anywhere.up_from_objects is None
+    assert relocalizer.up_from_objects is None  # an envelope given is used as given
     skipped = relocalizer.relocalize([E.Observation(999, E.Ellipse([320, 240], [40, 20]))])
     assert skipped.skipped and skipped.skipped[0][0] == 0
 

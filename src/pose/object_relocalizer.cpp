@@ -71,8 +71,13 @@ std::string invalidInput(const Intrinsics& K, const std::optional<GravityPrior>&
 
 ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
     : map_(std::move(map)), K_(K), options_(std::move(options)) {
-  if (!options_.envelope && options_.map_envelope && map_.camera_envelope && map_.camera_envelope->isValid())
-    options_.envelope = map_.camera_envelope;
+  if (!options_.envelope && options_.map_envelope) {
+    if (map_.camera_envelope && map_.camera_envelope->isValid()) {
+      options_.envelope = map_.camera_envelope;
+    } else if ((up_from_objects_ = estimateMapUp(map_))) {
+      options_.envelope = CameraEnvelope::upright(up_from_objects_->up, 90.0);
+    }
+  }
   for (const MapObject& o : map_.objects)
     if (const std::string problem = mapObjectProblem(o); !problem.empty())
       left_out_.push_back("object " + std::to_string(o.id) + ": " + problem);

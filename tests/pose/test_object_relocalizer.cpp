@@ -726,3 +726,46 @@ TEST(ObjectRelocalizer, TheMapsEnvelopeGatesPosesByDefault) {
   EXPECT_TRUE(found(relocalize(RelocalizerOptions{})));
   EXPECT_FALSE(RelocalizerOptions::oaSlam().map_envelope);
 }
+
+// A map without an envelope whose objects tell its up (estimateMapUp: office objects at their
+// usual heights on a z-up floor) keeps the camera upright: a camera rolled upside down is never
+// the answer, though its own detections would give it; turned off, it is found.
+TEST(ObjectRelocalizer, KeepsTheCameraUprightAboutTheUpTheMapsObjectsTell) {
+  std::mt19937 rng(13);
+  const std::vector<int> categories = {56, 62, 66, 41, 73, 64, 39, 58};  // chair tv keyboard cup book mouse...
+  ObjectMap map;
+  for (int i = 0; i < 24; ++i) {
+    const int c = categories[static_cast<size_t>(i) % categories.size()];
+    map.objects.push_back({i, c, "",
+                           Ellipsoid({uniform(rng, -2.0, 2.0), uniform(rng, -2.0, 2.0), typicalCentreHeight(c)},
+                                     {0.15, 0.1, 0.08}, Eigen::Matrix3d::Identity())});
+  }
+  const Intrinsics K = test::testIntrinsics();
+  const ObjectRelocalizer upright(map, K);
+  ASSERT_TRUE(upright.upFromObjects());
+  EXPECT_GT(upright.upFromObjects()->up.z(), 0.99);
+  ASSERT_TRUE(upright.options().envelope);
+  EXPECT_EQ(upright.options().envelope->max_tilt_deg, 90.0);
+  EXPECT_LT((upright.options().envelope->up - upright.upFromObjects()->up).norm(), 1e-12);
+  RelocalizerOptions anywhere;
+  anywhere.map_envelope = false;
+  EXPECT_FALSE(ObjectRelocalizer(map, K, anywhere).options().envelope);
+  EXPECT_FALSE(ObjectRelocalizer(map, K, anywhere).upFromObjects());
+  ObjectMap with_envelope = map;
+  with_envelope.camera_envelope = CameraEnvelope::upright(Eigen::Vector3d::UnitY());
+  EXPECT_FALSE(ObjectRelocalizer(with_envelope, K).upFromObjects());
+  EXPECT_EQ(ObjectRelocalizer(with_envelope, K).options().envelope->up, Eigen::Vector3d::UnitY());
+
+  const Pose level = Pose::lookAt({0.0, -4.5, 1.0}, {0.0, 0.0, 0.8});
+  const Eigen::Matrix3d roll = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Pose upside_down(roll * level.rotation(), roll * level.translation());
+  const std::vector<Observation> observations = sim::observeMap(map, K, upside_down, {}, &rng);
+  ASSERT_GE(observations.size(), 6u);
+  const RelocalizationResult free = ObjectRelocalizer(map, K, anywhere).relocalize(observations);
+  ASSERT_EQ(free.status, RelocalizationStatus::Success) << free.reason;
+  EXPECT_LT(positionError(free.pose, upside_down), 0.02);
+  const RelocalizationResult kept = upright.relocalize(observations);
+  EXPECT_NE(kept.status, RelocalizationStatus::Success);
+  if (kept.status == RelocalizationStatus::LowEvidence)  // a withheld pose is upright too
+    EXPECT_LE(CameraEnvelope::tiltDegOf(kept.pose, Eigen::Vector3d::UnitZ()), 90.0);
+}

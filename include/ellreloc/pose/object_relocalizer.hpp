@@ -26,6 +26,7 @@
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/map_up.hpp"
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/core/observation.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
@@ -134,9 +135,13 @@ class ObjectRelocalizer {
   const Intrinsics& intrinsics() const { return K_; }
   /// The options in use: `envelope` is the map's camera_envelope when it came from there.
   const RelocalizerOptions& options() const { return options_; }
+  /// The up the map's objects tell (estimateMapUp), when the envelope in use was taken from it:
+  /// a map without a camera_envelope, RelocalizerOptions::map_envelope and no `envelope` given.
+  const std::optional<MapUp>& upFromObjects() const { return up_from_objects_; }
 
  private:
   ObjectMap map_;
+  std::optional<MapUp> up_from_objects_;
   std::vector<std::string> left_out_;
   Intrinsics K_;
   RelocalizerOptions options_;

@@ -148,11 +148,12 @@ struct RelocalizerOptions {
   RefinementStageOptions refinement;
   AcceptanceOptions acceptance;
   /// Where the camera can be (camera_envelope.hpp, e.g. from the mapping keyframes): poses
-  /// outside are never hypotheses. None: the map's own (ObjectMap::camera_envelope) when
-  /// `map_envelope` and the map has one, else anywhere.
+  /// outside are never hypotheses. None: what `map_envelope` takes from the map, else anywhere.
   std::optional<CameraEnvelope> envelope;
-  /// Without `envelope`, keep the camera within the map's camera_envelope when it has one
-  /// (maps built by the Mapper record where their keyframes were taken).
+  /// Without `envelope`, keep the camera where the map says: within its camera_envelope when it
+  /// has one (maps built by the Mapper record where their keyframes were taken), else upright
+  /// (image-up within 90 degrees of up, any height) about the up its objects tell when they
+  /// tell it clearly (estimateMapUp, map_up.hpp), else anywhere.
   bool map_envelope = true;
 
   /// OA-SLAM's relocalization as a baseline: every detection triplet against every object
