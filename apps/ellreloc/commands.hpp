@@ -69,6 +69,7 @@ struct RelocalizeArgs {
   std::string envelope;          ///< TUM trajectory of the mapping keyframes: poses outside their envelope are dropped
   bool no_map_envelope = false;  ///< ignore the map's own camera envelope
   double max_tilt_deg = -1.0;    ///< with map_up: the camera's image-up within this of up (< 0: not given)
+  double max_roll_deg = 90.0;    ///< with max_tilt_deg: the camera's image rows within this of level
   bool use_points = false;       ///< refine with the frames' keypoints matched to the map's points
   std::string points;            ///< a file with the keypoints; empty: the detections file's own
   int threads = 1;

@@ -92,13 +92,20 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
           ->expected(3)
           ->delimiter(',');
   camera_up->needs(map_up);
-  r->add_option("--max-tilt", a.max_tilt_deg,
-                "with --map-up and no mapping poses: the camera's image-up stays within this many degrees of the "
-                "map's up, at any height (90: never upside down); replaces the map's camera_envelope")
-      ->check(CLI::Range(0.0, 180.0))
-      ->needs(map_up)
-      ->excludes("--envelope")
-      ->excludes(no_map_envelope);
+  auto* max_tilt =
+      r->add_option("--max-tilt", a.max_tilt_deg,
+                    "with --map-up and no mapping poses: the camera's image-up stays within this many degrees of the "
+                    "map's up, at any height (90: never upside down); replaces the map's camera_envelope")
+          ->check(CLI::Range(0.0, 180.0))
+          ->needs(map_up)
+          ->excludes("--envelope")
+          ->excludes(no_map_envelope);
+  r->add_option("--max-roll", a.max_roll_deg,
+                "with --max-tilt: the camera's image rows stay within this many degrees of level (90: any roll; "
+                "for an up near the vertical: about a tilted one a level camera looking another way rolls)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 90.0))
+      ->needs(max_tilt);
   r->add_option("--gravity-sigma", a.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
       ->capture_default_str()
       ->needs(camera_up);
@@ -208,11 +215,15 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
     if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
   }
   if (std::isnan(a.max_tilt_deg)) throw Error("--max-tilt: expected a number of degrees, not NaN");
+  if (std::isnan(a.max_roll_deg)) throw Error("--max-roll: expected a number of degrees, not NaN");
   if (a.map_up.size() == 3 && a.camera_up.empty() && a.envelope.empty() && a.max_tilt_deg < 0.0)
     throw Error("--map-up alone does nothing: add --camera-up (gravity prior), --envelope or --max-tilt");
   if (a.max_tilt_deg >= 0.0) {
-    options.envelope = CameraEnvelope::upright(Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]), a.max_tilt_deg);
-    if (!options.envelope) throw Error("--max-tilt/--map-up: expected a finite, non-zero up and a tilt in (0, 180]");
+    options.envelope =
+        CameraEnvelope::upright(Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]), a.max_tilt_deg, a.max_roll_deg);
+    if (!options.envelope)
+      throw Error(
+          "--max-tilt/--max-roll/--map-up: expected a finite, non-zero up, a tilt in (0, 180] and a roll in (0, 90]");
   }
   if (const std::string problem = options.validate(); !problem.empty()) throw Error("options: " + problem);
   return options;

@@ -50,12 +50,13 @@ class CameraEnvelope:
     @staticmethod
     def from_keyframes(keyframes: list[Pose], up: ArrayLike | None = ..., height_margin: float = ..., tilt_margin_deg: float = ...) -> CameraEnvelope: """The envelope of mapping keyframes, widened by the margins."""
     @staticmethod
-    def upright(up: ArrayLike | None, max_tilt_deg: float = ...) -> CameraEnvelope: """A camera at any height whose image-up stays within max_tilt_deg of `up` (90: never upside down)."""
+    def upright(up: ArrayLike | None, max_tilt_deg: float = ..., max_roll_deg: float = ...) -> CameraEnvelope: """A camera at any height whose image-up stays within max_tilt_deg of `up` (90: never upside down) and whose image rows stay within max_roll_deg of level (90: any roll; needs `up` near the vertical)."""
     up: numpy.ndarray
     min_height: float
     max_height: float
     min_tilt_deg: float
     max_tilt_deg: float
+    max_roll_deg: float
     def admits(self, pose: Pose) -> bool: ...
 
 

@@ -268,18 +268,22 @@ void bindPriors(py::module_& m) {
           py::arg("tilt_margin_deg") = 20.0, "The envelope of mapping keyframes, widened by the margins.")
       .def_static(
           "upright",
-          [](const py::handle& up, double max_tilt_deg) {
-            auto e = CameraEnvelope::upright(vector<3>(up, "up"), max_tilt_deg);
-            if (!e) badArgument("upright", "needs a finite, non-zero up and max_tilt_deg in (0, 180]");
+          [](const py::handle& up, double max_tilt_deg, double max_roll_deg) {
+            auto e = CameraEnvelope::upright(vector<3>(up, "up"), max_tilt_deg, max_roll_deg);
+            if (!e)
+              badArgument("upright",
+                          "needs a finite, non-zero up, max_tilt_deg in (0, 180] and max_roll_deg in (0, 90]");
             return *e;
           },
-          py::arg("up"), py::arg("max_tilt_deg") = 90.0,
-          "A camera at any height whose image-up stays within max_tilt_deg of `up` (90: never upside down).")
+          py::arg("up"), py::arg("max_tilt_deg") = 90.0, py::arg("max_roll_deg") = 90.0,
+          "A camera at any height whose image-up stays within max_tilt_deg of `up` (90: never upside down) and "
+          "whose image rows stay within max_roll_deg of level (90: any roll; needs `up` near the vertical).")
       .def_property_readonly("up", [](const CameraEnvelope& e) { return toArray(e.up); })
       .def_readonly("min_height", &CameraEnvelope::min_height)
       .def_readonly("max_height", &CameraEnvelope::max_height)
       .def_readonly("min_tilt_deg", &CameraEnvelope::min_tilt_deg)
       .def_readonly("max_tilt_deg", &CameraEnvelope::max_tilt_deg)
+      .def_readonly("max_roll_deg", &CameraEnvelope::max_roll_deg)
       .def("admits", &CameraEnvelope::admits, py::arg("pose"));
 }
 

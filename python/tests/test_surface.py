@@ -149,6 +149,14 @@ def test_results_and_envelope(fr2, data_dir):
         E.CameraEnvelope.upright([0, 0, 0])
     with pytest.raises(ValueError):
         E.CameraEnvelope.upright([0, 0, 1], 0)
+    with pytest.raises(ValueError, match="max_roll_deg"):
+        E.CameraEnvelope.upright([0, 0, 1], 90, 0)
+    # The vertical, independently of the map: the up most orthogonal to the keyframes' image rows.
+    rights = np.array([p.pose.T_wc[:3, 0] for p in truth])
+    vertical = np.linalg.eigh(rights.T @ rights)[1][:, 0]
+    vertical *= np.sign(vertical @ envelope.up)
+    level = E.CameraEnvelope.upright(vertical, 90, 45)  # keyframes roll at most 12 degrees
+    assert level.max_roll_deg == 45 and all(level.admits(p.pose) for p in truth)
     relocalizer = E.ObjectRelocalizer(map_, camera, envelope=envelope)
     r = relocalizer.relocalize(frames[0])
     assert isinstance(r, E.RelocalizationResult) and r.success and r.hypotheses > 0 and r.iterations >= 0
@@ -160,16 +168,14 @@ def test_results_and_envelope(fr2, data_dir):
     none = E.ObjectRelocalizer(map_, camera, search={"budget": budget}).relocalize(frames[0])
     assert none.status == E.RelocalizationStatus.no_consistent_hypothesis and none.reason
     # The fr2 map has no camera envelope: its objects tell its up, which the relocalizer keeps the
-    # camera upright about. Independently: the up most orthogonal to the keyframes' image-right axes.
-    rights = np.array([p.pose.T_wc[:3, 0] for p in truth])
-    vertical = np.linalg.eigh(rights.T @ rights)[1][:, 0]
-    vertical *= np.sign(vertical @ envelope.up)
+    # camera upright about.
     found = E.estimate_map_up(map_)
     assert found["objects"] == 45 and found["t"] >= 2.5 and found["up"] @ vertical > math.cos(math.radians(10))
     assert E.estimate_map_up(map_, min_t=10) is None
     upright_by_objects = E.ObjectRelocalizer(map_, camera, envelope=None)
     assert upright_by_objects.up_from_objects["up"].tolist() == found["up"].tolist()
     assert upright_by_objects.options.envelope.max_tilt_deg == 90
+    assert upright_by_objects.options.envelope.max_roll_deg == 45
     np.testing.assert_allclose(upright_by_objects.options.envelope.up, found["up"])
     anywhere = E.ObjectRelocalizer(map_, camera, map_envelope=False)
     assert anywhere.options.envelope is None and anywhere.up_from_objects is None

@@ -371,6 +371,12 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                            "/keyframes.detections.json --map-up 0,-1,0 --max-tilt nan"},
       {"max tilt with a zero up", reloc + "--map " + d + "/map.json --detections " + d +
                                       "/keyframes.detections.json --map-up 0,0,0 --max-tilt 90"},
+      {"max roll without max tilt", reloc + "--map " + d + "/map.json --detections " + d +
+                                        "/keyframes.detections.json --map-up 0,-1,0 --max-roll 45"},
+      {"max roll of zero", reloc + "--map " + d + "/map.json --detections " + d +
+                               "/keyframes.detections.json --map-up 0,-1,0 --max-tilt 90 --max-roll 0"},
+      {"NaN max roll", reloc + "--map " + d + "/map.json --detections " + d +
+                           "/keyframes.detections.json --map-up 0,-1,0 --max-tilt 90 --max-roll nan"},
       {"max tilt and mapping poses", reloc + "--map " + d + "/map.json --detections " + d +
                                          "/keyframes.detections.json --map-up 0,-1,0 --max-tilt 90 --envelope " + d +
                                          "/keyframes.groundtruth.txt"},

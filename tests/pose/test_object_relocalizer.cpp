@@ -673,6 +673,33 @@ TEST(CameraEnvelope, UprightBoundsTheTiltAtAnyHeight) {
   EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d(0.0, NAN, 1.0)));
   EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 0.0));
   EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 181.0));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 90.0, 0.0));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 90.0, 91.0));
+}
+
+// A roll bound keeps the image rows near level: a camera looking down at 50 degrees passes at
+// any heading, one rolled 30 degrees about its optical axis passes 45 but not 20.
+TEST(CameraEnvelope, RollBoundsTheHorizon) {
+  const auto e = CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 90.0, 45.0);
+  ASSERT_TRUE(e);
+  EXPECT_TRUE(e->isValid());
+  for (double heading = 0.0; heading < 2 * M_PI; heading += 0.5) {
+    const double rise = std::tan(50 * M_PI / 180);  // 50 degrees down from a metre away
+    const Pose down = Pose::lookAt({std::cos(heading), std::sin(heading), 1.2 + rise}, {0, 0, 1.2});
+    EXPECT_NEAR(CameraEnvelope::rollDegOf(down, e->up), 0.0, 1e-9);
+    EXPECT_TRUE(e->admits(down));
+  }
+  const Pose level = Pose::lookAt({2.0, 0.0, 0.8}, {0.0, 0.0, 0.8});
+  const Eigen::Matrix3d roll = Eigen::AngleAxisd(30 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Pose rolled(roll * level.rotation(), roll * level.translation());
+  EXPECT_NEAR(CameraEnvelope::rollDegOf(rolled, e->up), 30.0, 1e-9);
+  EXPECT_NEAR(CameraEnvelope::tiltDegOf(rolled, e->up), 30.0, 1e-9);
+  EXPECT_TRUE(e->admits(rolled));
+  EXPECT_FALSE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 90.0, 20.0)->admits(rolled));
+  EXPECT_TRUE(CameraEnvelope::upright(Eigen::Vector3d::UnitZ(), 90.0)->admits(rolled));
+  CameraEnvelope bad = *e;
+  bad.max_roll_deg = 0.0;
+  EXPECT_FALSE(bad.isValid());
 }
 
 // Relocalization never returns a pose outside the envelope: with the true pose inside it, the
@@ -746,6 +773,7 @@ TEST(ObjectRelocalizer, KeepsTheCameraUprightAboutTheUpTheMapsObjectsTell) {
   EXPECT_GT(upright.upFromObjects()->up.z(), 0.99);
   ASSERT_TRUE(upright.options().envelope);
   EXPECT_EQ(upright.options().envelope->max_tilt_deg, 90.0);
+  EXPECT_EQ(upright.options().envelope->max_roll_deg, 45.0);
   EXPECT_LT((upright.options().envelope->up - upright.upFromObjects()->up).norm(), 1e-12);
   RelocalizerOptions anywhere;
   anywhere.map_envelope = false;

@@ -22,11 +22,14 @@ struct CameraEnvelope {
   /// Angle between the camera's image-up direction (-y) and `up`: 0 for a level camera, 90 for
   /// one looking straight down or up.
   double min_tilt_deg = 0.0, max_tilt_deg = 180.0;
+  /// Angle between the camera's image rows (+x) and the plane normal to `up`: 0 for a level
+  /// horizon, 90 (no bound) for a camera on its side. Not stored in map files.
+  double max_roll_deg = 90.0;
 
   bool isValid() const {
     return up.allFinite() && std::abs(up.norm() - 1.0) < 1e-6 && std::isfinite(min_height) &&
            std::isfinite(max_height) && min_height <= max_height && std::isfinite(min_tilt_deg) &&
-           std::isfinite(max_tilt_deg) && min_tilt_deg <= max_tilt_deg;
+           std::isfinite(max_tilt_deg) && min_tilt_deg <= max_tilt_deg && max_roll_deg > 0.0 && max_roll_deg <= 90.0;
   }
 
   static double heightOf(const Pose& pose, const Eigen::Vector3d& up) { return up.dot(pose.center()); }
@@ -34,21 +37,35 @@ struct CameraEnvelope {
     const Eigen::Vector3d image_up = -pose.rotation().transpose().col(1);  // camera -y in the world
     return std::acos(std::clamp(image_up.dot(up), -1.0, 1.0)) * 180.0 / M_PI;
   }
+  static double rollDegOf(const Pose& pose, const Eigen::Vector3d& up) {
+    const Eigen::Vector3d image_right = pose.rotation().row(0).transpose();  // camera +x in the world
+    return std::abs(std::asin(std::clamp(image_right.dot(up), -1.0, 1.0))) * 180.0 / M_PI;
+  }
 
   /// The world->camera pose lies within the envelope.
   bool admits(const Pose& pose) const {
     const double h = heightOf(pose, up), t = tiltDegOf(pose, up);
+    if (max_roll_deg < 90.0 &&
+        std::abs(pose.rotation().row(0).dot(up)) > std::sin(max_roll_deg * M_PI / 180.0))  // rollDegOf, no asin
+      return false;
     return h >= min_height && h <= max_height && t >= min_tilt_deg && t <= max_tilt_deg;
   }
 
-  /// A camera at any height whose image-up stays within `max_tilt_deg` of the world's `up`: for
-  /// a host that knows which way is up in its map but has no mapping poses (90: the camera is
-  /// never upside down). nullopt for a zero or non-finite `up` or a tilt outside (0, 180].
-  static std::optional<CameraEnvelope> upright(const Eigen::Vector3d& up, double max_tilt_deg = 90.0) {
-    if (!up.allFinite() || !(up.norm() > 1e-9) || !(max_tilt_deg > 0.0 && max_tilt_deg <= 180.0)) return std::nullopt;
+  /// A camera at any height whose image-up stays within `max_tilt_deg` of the world's `up`, and
+  /// whose image rows stay within `max_roll_deg` of level: for a host that knows which way is up
+  /// in its map but has no mapping poses (90 and 90: the camera is never upside down). A roll
+  /// bound needs `up` close to the vertical: about a tilted one a level camera looking another
+  /// way rolls. nullopt for a zero or non-finite `up`, a tilt outside (0, 180] or a roll outside
+  /// (0, 90].
+  static std::optional<CameraEnvelope> upright(const Eigen::Vector3d& up, double max_tilt_deg = 90.0,
+                                               double max_roll_deg = 90.0) {
+    if (!up.allFinite() || !(up.norm() > 1e-9) || !(max_tilt_deg > 0.0 && max_tilt_deg <= 180.0) ||
+        !(max_roll_deg > 0.0 && max_roll_deg <= 90.0))
+      return std::nullopt;
     CameraEnvelope e;
     e.up = up.normalized();
     e.max_tilt_deg = max_tilt_deg;
+    e.max_roll_deg = max_roll_deg;
     return e;
   }
 

@@ -152,8 +152,8 @@ struct RelocalizerOptions {
   std::optional<CameraEnvelope> envelope;
   /// Without `envelope`, keep the camera where the map says: within its camera_envelope when it
   /// has one (maps built by the Mapper record where their keyframes were taken), else upright
-  /// (image-up within 90 degrees of up, any height) about the up its objects tell when they
-  /// tell it clearly (estimateMapUp, map_up.hpp), else anywhere.
+  /// (image-up within 90 degrees of up, image rows within 45 of level, any height) about the up
+  /// its objects tell when they tell it clearly (estimateMapUp, map_up.hpp), else anywhere.
   bool map_envelope = true;
 
   /// OA-SLAM's relocalization as a baseline: every detection triplet against every object
@@ -224,7 +224,7 @@ struct RelocalizerOptions {
     if (!(std::isfinite(acceptance.min_margin) && acceptance.min_margin >= 0))
       return "acceptance.min_margin is negative or not finite";
     if (envelope && !envelope->isValid())
-      return "envelope has a non-unit or non-finite up, or an empty or non-finite range";
+      return "envelope has a non-unit or non-finite up, an empty or non-finite range, or a roll bound outside (0, 90]";
     return "";
   }
 };
