@@ -353,9 +353,10 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const ObjectRelocalizer relocalizer(object_map, K, options);
   if (const auto& up = relocalizer.upFromObjects(); up && !console.quiet)
     std::printf(
-        "%s has no camera envelope: the camera is kept upright about the up its objects tell, (%.3f, %.3f, "
-        "%.3f) (t = %.1f over %d objects; --no-map-envelope: anywhere)\n",
-        a.map.c_str(), up->up.x(), up->up.y(), up->up.z(), up->t, up->objects);
+        "%s has no camera envelope: the camera is kept upright, its horizon within %.0f degrees of level, about "
+        "the up its objects tell: (%.3f, %.3f, %.3f), t = %.1f over %d objects (--no-map-envelope: anywhere)\n",
+        a.map.c_str(), relocalizer.options().envelope->max_roll_deg, up->up.x(), up->up.y(), up->up.z(), up->t,
+        up->objects);
   std::optional<GravityPrior> gravity;
   if (a.camera_up.size() == 3 && a.map_up.size() == 3) {
     gravity = GravityPrior{
