@@ -55,8 +55,8 @@ struct MapUp {
 /// objects' centres, signed so that the usual heights of their categories rise along it. Given
 /// only when the evidence is clear: at least 8 objects of categories with a usual height, the
 /// least spread at most 0.75 of the next (the direction is defined), and the heights correlated
-/// with the positions along it with a t statistic of at least `min_t` (2.5: below one chance in a
-/// hundred that unrelated heights give as much) and more than along either other principal
+/// with the positions along it with a t statistic of at least `min_t` (2.5: about one chance in
+/// sixty that unrelated heights give as much) and more than along either other principal
 /// direction (which a horizontal direction of least spread, objects along one wall, would fail).
 /// nullopt otherwise.
 inline std::optional<MapUp> estimateMapUp(const ObjectMap& map, double min_t = 2.5) {
