@@ -62,12 +62,16 @@ struct MapUp {
 inline std::optional<MapUp> estimateMapUp(const ObjectMap& map, double min_t = 2.5) {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> heights;
+  std::vector<size_t> known;  // the centres of a category with a usual height
   for (const MapObject& o : map.objects) {
     if (!mapObjectUsable(o)) continue;
+    const double height = typicalCentreHeight(o.category);
+    if (std::isfinite(height)) known.push_back(centres.size());
     centres.push_back(o.ellipsoid.center());
-    heights.push_back(typicalCentreHeight(o.category));
+    heights.push_back(height);
   }
-  if (centres.size() < 3) return std::nullopt;
+  const int n = static_cast<int>(known.size());
+  if (n < 8) return std::nullopt;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& c : centres) mean += c;
   mean /= static_cast<double>(centres.size());
@@ -78,11 +82,6 @@ inline std::optional<MapUp> estimateMapUp(const ObjectMap& map, double min_t = 2
   if (spread.info() != Eigen::Success || !(variances(0) <= 0.75 * 0.75 * variances(1))) return std::nullopt;
 
   // Pearson correlation of the usual heights with the positions along each principal direction.
-  std::vector<size_t> known;
-  for (size_t i = 0; i < heights.size(); ++i)
-    if (std::isfinite(heights[i])) known.push_back(i);
-  const int n = static_cast<int>(known.size());
-  if (n < 8) return std::nullopt;
   double mean_h = 0.0;
   for (size_t i : known) mean_h += heights[i];
   mean_h /= n;
