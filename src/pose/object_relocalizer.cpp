@@ -188,7 +188,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
   const PoseGate gate{gravity ? &*gravity : nullptr, options_.gravity.gate_deg,
-                      options_.envelope ? &*options_.envelope : nullptr};
+                      options_.envelope ? std::optional(options_.envelope->prepared()) : std::nullopt};
   HypothesisPool pool(options_.refinement.top_k);
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;

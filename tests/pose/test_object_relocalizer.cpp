@@ -702,6 +702,34 @@ TEST(CameraEnvelope, RollBoundsTheHorizon) {
   EXPECT_FALSE(bad.isValid());
 }
 
+// admits() tests cosines and a sine prepared once; it says what the angles say, at any pose.
+TEST(CameraEnvelope, AdmitsWhatItsAnglesAndHeightsSay) {
+  CameraEnvelope e;
+  e.up = Eigen::Vector3d(0.3, -0.2, 1.0).normalized();
+  e.min_height = 0.5, e.max_height = 1.8;
+  e.min_tilt_deg = 10.0, e.max_tilt_deg = 70.0, e.max_roll_deg = 30.0;
+  ASSERT_TRUE(e.isValid());
+  std::mt19937 rng(41);
+  std::normal_distribution<double> normal;
+  int admitted = 0, compared = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+    const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+    const Eigen::Vector3d centre(normal(rng), normal(rng), 1.2 + normal(rng));
+    const Pose pose(R, -R * centre);
+    const double h = CameraEnvelope::heightOf(pose, e.up), t = CameraEnvelope::tiltDegOf(pose, e.up);
+    const double r = CameraEnvelope::rollDegOf(pose, e.up);
+    const auto near = [](double x, double bound) { return std::abs(x - bound) < 1e-6; };
+    if (near(h, 0.5) || near(h, 1.8) || near(t, 10.0) || near(t, 70.0) || near(r, 30.0)) continue;
+    const bool inside = h >= 0.5 && h <= 1.8 && t >= 10.0 && t <= 70.0 && r <= 30.0;
+    EXPECT_EQ(e.admits(pose), inside) << "height " << h << " tilt " << t << " roll " << r;
+    admitted += inside;
+    ++compared;
+  }
+  EXPECT_GT(admitted, 100);  // both answers are exercised
+  EXPECT_LT(admitted, compared - 100);
+}
+
 // Relocalization never returns a pose outside the envelope: with the true pose inside it, the
 // pose is found; with an envelope that excludes it, the true pose is not returned.
 TEST(ObjectRelocalizer, EnvelopeGatesPoses) {

@@ -42,14 +42,31 @@ struct CameraEnvelope {
     return std::abs(std::asin(std::clamp(image_right.dot(up), -1.0, 1.0))) * 180.0 / M_PI;
   }
 
-  /// The world->camera pose lies within the envelope.
-  bool admits(const Pose& pose) const {
-    const double h = heightOf(pose, up), t = tiltDegOf(pose, up);
-    if (max_roll_deg < 90.0 &&
-        std::abs(pose.rotation().row(0).dot(up)) > std::sin(max_roll_deg * M_PI / 180.0))  // rollDegOf, no asin
-      return false;
-    return h >= min_height && h <= max_height && t >= min_tilt_deg && t <= max_tilt_deg;
+  /// The bounds as a pose is tested against them: the tilts as cosines and the roll as a sine,
+  /// computed once for the many poses of a search instead of an arc cosine per pose.
+  struct Prepared {
+    Eigen::Vector3d up;
+    double min_height, max_height;
+    double min_up_cos, max_up_cos;  // image-up . up: cos(max_tilt) .. cos(min_tilt)
+    double max_right_sin;           // |image-right . up| <= sin(max_roll); above 1 without a bound
+    bool admits(const Pose& pose) const {
+      const double h = heightOf(pose, up), c = -pose.rotation().row(1).dot(up);
+      return h >= min_height && h <= max_height && c >= min_up_cos && c <= max_up_cos &&
+             std::abs(pose.rotation().row(0).dot(up)) <= max_right_sin;
+    }
+  };
+  Prepared prepared() const {
+    const double deg = M_PI / 180.0;
+    return {up,
+            min_height,
+            max_height,
+            max_tilt_deg >= 180.0 ? -2.0 : std::cos(max_tilt_deg * deg),
+            min_tilt_deg <= 0.0 ? 2.0 : std::cos(min_tilt_deg * deg),
+            max_roll_deg >= 90.0 ? 2.0 : std::sin(max_roll_deg * deg)};
   }
+
+  /// The world->camera pose lies within the envelope.
+  bool admits(const Pose& pose) const { return prepared().admits(pose); }
 
   /// A camera at any height whose image-up stays within `max_tilt_deg` of the world's `up`, and
   /// whose image rows stay within `max_roll_deg` of level: for a host that knows which way is up

@@ -21,7 +21,7 @@ namespace ellreloc::pipeline {
 struct PoseGate {
   const GravityPrior* prior = nullptr;  // none: every pose passes
   double gate_deg = 15.0;
-  const CameraEnvelope* envelope = nullptr;  // none: anywhere
+  std::optional<CameraEnvelope::Prepared> envelope;  // none: anywhere
   bool admits(const Pose& pose) const {
     return (!prior || prior->errorDeg(pose) <= std::max(gate_deg, 5.0 * prior->sigma_deg)) &&
            (!envelope || envelope->admits(pose));
