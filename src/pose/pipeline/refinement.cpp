@@ -58,7 +58,7 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
   PoseScorer& scorer = *scorers.front();
   ChosenPose best;
   best.pose = search_best;
-  best.cost = scorer.cost(search_best, kReportIoUVertices);
+  best.cost = scorer.cost(search_best, kReportIoUVertices, &best.matches);
   std::vector<Pose> starts;
   for (const ScoredPose& h : pool.entries()) {
     if (h.cost > pool.best().cost + context.options.refinement.cost_margin) break;  // ascending costs
@@ -81,8 +81,8 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
       best.pose = candidate.pose;
       best.cost = candidate.cost;
       best.refined = candidate.refined;
+      best.matches = candidate.matches;  // refineRounds' matches are its pose's
     }
-  best.cost = scorer.cost(best.pose, kReportIoUVertices, &best.matches);
   // A rival that refines to another answer almost as well means look-alike objects or a
   // symmetric layout: the frame cannot tell the two apart.
   for (const ChosenPose& candidate : refined) {
