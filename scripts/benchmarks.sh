@@ -67,8 +67,9 @@ if [ -d "$build/python/ellreloc" ] && [ -n "$python" ]; then
   table python_overhead env PYTHONPATH="$build/python" "$python" benchmarks/python_overhead.py
   table regular_verdict env PYTHONPATH="$build/python" "$python" benchmarks/regular_verdict.py \
     "$data/independent_synth/office_s11" "$out/scenes/sim_office_1" "$out/scenes/sim_office_2"
+  table split_map_limits env PYTHONPATH="$build/python" "$python" scripts/split_map_limits.py "$build" "$data"
 else
-  echo "benchmarks: python_overhead and regular_verdict skipped (no Python bindings in $build)" >&2
+  echo "benchmarks: python_overhead, regular_verdict and split_map_limits skipped (no Python bindings in $build)" >&2
 fi
 table startup python3 benchmarks/startup.py "$build" "$data" "$python"
 
