@@ -12,6 +12,7 @@ pose reported (`ellreloc relocalize --accept-all`).
 Usage: PYTHONPATH=BUILD/python python3 scripts/split_map_limits.py [BUILD_DIR] [DATA_DIR]
 (needs the Python bindings and numpy; prints a Markdown table)
 """
+import copy
 import json
 import os
 import sys
@@ -30,14 +31,9 @@ SAME, NEAR = 0.005, 0.3  # metres: an object unchanged, an object held by the sp
 
 
 def posed(camera_frames, trajectory):
-    """(pose, detections) of each frame with a ground-truth pose within 20 ms."""
-    stamps = np.array([p.timestamp for p in trajectory])
-    out = []
-    for frame in camera_frames:
-        i = int(np.argmin(np.abs(stamps - frame.timestamp)))
-        if abs(stamps[i] - frame.timestamp) < 0.02:
-            out.append((trajectory[i].pose, frame.detections))
-    return out
+    """(pose, detections) of each frame with a ground-truth pose (ellreloc.find_nearest's 20 ms)."""
+    nearest_pose = [ellreloc.find_nearest(trajectory, frame.timestamp) for frame in camera_frames]
+    return [(trajectory[i].pose, frame.detections) for i, frame in zip(nearest_pose, camera_frames) if i is not None]
 
 
 def nearest(obj, objects):
@@ -85,18 +81,18 @@ def main():
         for k, (name, mapping, query) in enumerate(chosen):
             split_path, query_path, _ = box_map(camera_path, groundtruth, mapping, query, work, str(k))
             split_json = json.load(open(split_path))
+            exchanged_json = copy.deepcopy(split_json)
             exchanged = 0
-            for obj in split_json["objects"]:
+            for obj in exchanged_json["objects"]:
                 twin, distance = nearest(obj, whole_json["objects"])
                 if SAME < distance < NEAR:
                     obj.update({key: twin[key] for key in ("center", "axes", "rotation")})
                     exchanged += 1
             exchanged_path = os.path.join(work, "%d.exchanged.map.json" % k)
-            json.dump(split_json, open(exchanged_path, "w"))
+            json.dump(exchanged_json, open(exchanged_path, "w"))
             split_map = ellreloc.read_map(split_path)
             query_frames = posed(ellreloc.read_detections(query_path), trajectory)
-            ious, mapped = box_by_box(split_map, whole_map, camera, query_frames, whole_json,
-                                      json.load(open(split_path)))
+            ious, mapped = box_by_box(split_map, whole_map, camera, query_frames, whole_json, split_json)
             quality = [ellreloc.map_quality(m, camera, query_frames).median_best_iou
                        for m in (split_map, whole_map, ellreloc.read_map(exchanged_path))]
             valid = [relocalize(camera_path, m, query_path, groundtruth, "ours", work, ("--accept-all",))["valid"]
