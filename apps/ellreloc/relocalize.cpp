@@ -102,7 +102,7 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
           ->excludes(no_map_envelope);
   r->add_option("--max-roll", a.max_roll_deg,
                 "with --max-tilt: the camera's image rows stay within this many degrees of level (90: any roll; "
-                "for an up near the vertical: about a tilted one a level camera looking another way rolls)")
+                "give an up near the vertical: about a tilted up even a level camera rolls as it turns)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 90.0))
       ->needs(max_tilt);
