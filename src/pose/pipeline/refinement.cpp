@@ -55,10 +55,6 @@ std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>
 ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
                             const std::vector<PoseScorer*>& scorers, const RefinementContext& context,
                             size_t max_refined) {
-  PoseScorer& scorer = *scorers.front();
-  ChosenPose best;
-  best.pose = search_best;
-  best.cost = scorer.cost(search_best, kReportIoUVertices, &best.matches);
   std::vector<Pose> starts;
   for (const ScoredPose& h : pool.entries()) {
     if (h.cost > pool.best().cost + context.options.refinement.cost_margin) break;  // ascending costs
@@ -76,6 +72,17 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
   for (size_t t = 1; t < std::min(scorers.size(), starts.size()); ++t) helpers.emplace_back(work, t);
   work(0);
   for (std::thread& h : helpers) h.join();
+  // When the search's best pose is the pool's first (nearly always), its refinement starts from
+  // the cost and matches it would be given here and keeps them unless refined to a cost as low
+  // (refineRounds), which the comparison below would take anyway: they are reused.
+  ChosenPose best;
+  if (!starts.empty() && starts[0].rotation() == search_best.rotation() &&
+      starts[0].translation() == search_best.translation()) {
+    best = refined[0];
+  } else {
+    best.pose = search_best;
+    best.cost = scorers.front()->cost(search_best, kReportIoUVertices, &best.matches);
+  }
   for (const ChosenPose& candidate : refined)
     if (candidate.cost < best.cost || (candidate.refined && candidate.cost <= best.cost)) {
       best.pose = candidate.pose;
