@@ -187,8 +187,9 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   // 2. Hypotheses into the pool: triplets, then pairs when the frame has few observations or
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
-  const PoseGate gate{gravity ? &*gravity : nullptr, options_.gravity.gate_deg,
-                      options_.envelope ? std::optional(options_.envelope->prepared()) : std::nullopt};
+  PoseGate gate;
+  if (gravity) gate.gravity = gravity->bound(std::max(options_.gravity.gate_deg, 5.0 * gravity->sigma_deg));
+  if (options_.envelope) gate.envelope = options_.envelope->prepared();
   HypothesisPool pool(options_.refinement.top_k);
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;

@@ -517,6 +517,28 @@ TEST(ObjectRelocalizer, GravityPriorGatesHypotheses) {
   }
 }
 
+// The gate's prepared bound says what errorDeg says, over random poses and bounds.
+TEST(GravityPrior, BoundAdmitsWhatTheAngleSays) {
+  std::mt19937 rng(43);
+  std::normal_distribution<double> normal;
+  GravityPrior prior;
+  prior.up_in_camera = Eigen::Vector3d(0.1, -2.0, 0.3);  // not unit length: the bound normalises
+  prior.up_in_map = Eigen::Vector3d(0.2, 0.1, 3.0);
+  int admitted = 0, compared = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+    const Pose pose(q.normalized().toRotationMatrix(), Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
+    const double max_deg = std::uniform_real_distribution<double>(0.0, 200.0)(rng);
+    const double angle = prior.errorDeg(pose);
+    if (std::abs(angle - max_deg) < 1e-6) continue;
+    EXPECT_EQ(prior.bound(max_deg).admits(pose), angle <= max_deg) << "angle " << angle << " bound " << max_deg;
+    admitted += angle <= max_deg;
+    ++compared;
+  }
+  EXPECT_GT(admitted, 1000);  // both answers are exercised
+  EXPECT_LT(admitted, compared - 1000);
+}
+
 // scorePose scores a given pose like relocalize() scores its own.
 TEST(ObjectRelocalizer, ScoresAGivenPose) {
   std::mt19937 rng(104);

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <limits>
 
 #include "ellreloc/core/camera.hpp"
 
@@ -31,6 +32,19 @@ struct GravityPrior {
   double errorDeg(const Pose& pose) const {
     const Eigen::Vector3d a = predictedUp(pose), b = up_in_camera.normalized();
     return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+  }
+
+  /// The test errorDeg(pose) <= max_deg prepared once for many poses: both ups of unit length
+  /// and the bound as a cosine, so that a pose costs a rotation and a dot product, no arc tangent.
+  struct Bound {
+    Eigen::Vector3d up_in_map, up_in_camera;  ///< unit length
+    double min_cos = -1.0;
+    bool admits(const Pose& pose) const { return (pose.rotation() * up_in_map).dot(up_in_camera) >= min_cos; }
+  };
+  Bound bound(double max_deg) const {
+    const double min_cos =
+        max_deg >= 180.0 ? -std::numeric_limits<double>::infinity() : std::cos(max_deg * M_PI / 180.0);
+    return {up_in_map.normalized(), up_in_camera.normalized(), min_cos};
   }
 
   /// The prior a gravity-aware host would measure at a known pose (tests, simulations).

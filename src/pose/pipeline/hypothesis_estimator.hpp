@@ -19,12 +19,10 @@ namespace ellreloc::pipeline {
 /// Drops poses that tilt the camera more than max(gate_deg, 5 sigma) away from a gravity prior,
 /// and poses outside the camera envelope.
 struct PoseGate {
-  const GravityPrior* prior = nullptr;  // none: every pose passes
-  double gate_deg = 15.0;
+  std::optional<GravityPrior::Bound> gravity;        // none: any tilt
   std::optional<CameraEnvelope::Prepared> envelope;  // none: anywhere
   bool admits(const Pose& pose) const {
-    return (!prior || prior->errorDeg(pose) <= std::max(gate_deg, 5.0 * prior->sigma_deg)) &&
-           (!envelope || envelope->admits(pose));
+    return (!gravity || gravity->admits(pose)) && (!envelope || envelope->admits(pose));
   }
 };
 
