@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <mutex>
 
@@ -366,6 +367,7 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
       ++report->new_objects;
     }
     t->views.push_back({pose, d.bbox});
+    t->keyframes_seen.push_back(keyframes_);
     observed(*t, d);
   }
   mergeDuplicateBoxTracks();
@@ -374,15 +376,32 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
 void Mapper::mergeDuplicateBoxTracks() {
   // Box tracking breaks when a small object moves more than its size between keyframes; the
   // pieces then give nearly the same ellipsoid. Two built objects of one label whose centres
-  // lie within the smaller one's mean semi-axis are one object: the younger joins the older.
+  // lie within the smaller one's mean semi-axis are one object (the younger joins the older),
+  // unless a keyframe detected both: a detector gives one box per object, so two boxes of one
+  // image are two objects (a book on another, two bottles side by side).
+  const auto detected_together = [](const Track& a, const Track& b) {
+    auto i = a.keyframes_seen.begin(), j = b.keyframes_seen.begin();
+    while (i != a.keyframes_seen.end() && j != b.keyframes_seen.end()) {
+      if (*i == *j) return true;
+      if (*i < *j)
+        ++i;
+      else
+        ++j;
+    }
+    return false;
+  };
   for (size_t i = 0; i < tracks_.size(); ++i) {
     for (size_t j = i + 1; j < tracks_.size(); ++j) {
       Track &a = tracks_[i], &b = tracks_[j];
       if (!a.built || !b.built || a.label() != b.label()) continue;
       const Ellipsoid &ea = a.built->object.ellipsoid, &eb = b.built->object.ellipsoid;
       const double reach = std::min(ea.axes().mean(), eb.axes().mean());
-      if ((ea.center() - eb.center()).norm() > reach) continue;
+      if ((ea.center() - eb.center()).norm() > reach || detected_together(a, b)) continue;
       a.views.insert(a.views.end(), b.views.begin(), b.views.end());
+      std::vector<int> seen;
+      std::merge(a.keyframes_seen.begin(), a.keyframes_seen.end(), b.keyframes_seen.begin(), b.keyframes_seen.end(),
+                 std::back_inserter(seen));
+      a.keyframes_seen = std::move(seen);
       for (const auto& [category, weight] : b.labels) a.labels[category] += weight;
       a.observations += b.observations;
       a.last_seen = std::max(a.last_seen, b.last_seen);

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <thread>
 
+#include "ellreloc/core/projection.hpp"
 #include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/map.hpp"
@@ -191,6 +192,61 @@ TEST(Mapper, BoxesOnlyMode) {
   }
   EXPECT_GE(expected, 3);
   EXPECT_GE(found, expected - 1);
+}
+
+/// The detection a box detector would give of an ellipsoid: its image's bounding box.
+Detection boxOf(const Ellipsoid& e, int category, const Intrinsics& K, const Pose& pose, double scale = 1.0) {
+  const Projection p = project(e, K, pose);
+  EXPECT_TRUE(p);
+  const Box b = p.ellipse.boundingBox();
+  const Eigen::Vector2d c(0.5 * (b.x1 + b.x2), 0.5 * (b.y1 + b.y2)), h(0.5 * scale * b.width(), 0.5 * scale * b.height());
+  Detection d;
+  d.category_id = category;
+  d.bbox = Box(c.x() - h.x(), c.y() - h.y(), c.x() + h.x(), c.y() + h.y());
+  return d;
+}
+
+/// Cameras on an arc 1.5 m from the origin, 0.8 m above it, looking at it.
+Pose arcPose(int i) {
+  const double a = -0.6 + 0.1 * i;
+  return Pose::lookAt(Eigen::Vector3d(1.5 * std::cos(a), 1.5 * std::sin(a), 0.8), Eigen::Vector3d(0, 0, 0.04));
+}
+
+// Boxes mode: two objects of one label whose centres lie within the smaller one's mean
+// semi-axis (a book lying on another) stay two objects when keyframes detected both, since a
+// detector gives one box per object; an object whose track broke (its boxes suddenly much
+// smaller, as if half hidden, so that tracking started again) is joined again.
+TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const int kBook = 73;
+  const Ellipsoid lower(Eigen::Vector3d(0, 0, 0.02), Eigen::Vector3d(0.12, 0.09, 0.02), Eigen::Matrix3d::Identity());
+  const Ellipsoid upper(Eigen::Vector3d(0.01, 0.01, 0.06), Eigen::Vector3d(0.1, 0.08, 0.02), Eigen::Matrix3d::Identity());
+  MapperOptions options;
+  options.mode = MappingMode::Boxes;
+  Mapper stacked(K, options);
+  for (int i = 0; i < 12; ++i) {
+    const Pose pose = arcPose(i);
+    stacked.addKeyframe(pose, {boxOf(lower, kBook, K, pose), boxOf(upper, kBook, K, pose)});
+  }
+  stacked.finish();
+  const ObjectMap two = stacked.map();
+  ASSERT_EQ(two.objects.size(), 2u);
+  const double apart = (two.objects[0].ellipsoid.center() - two.objects[1].ellipsoid.center()).norm();
+  const double reach = std::min(two.objects[0].ellipsoid.axes().mean(), two.objects[1].ellipsoid.axes().mean());
+  EXPECT_LT(apart, reach);  // close enough for the centre test alone to join them
+
+  Mapper broken(K, options);
+  int created = 0;
+  for (int i = 0; i < 12; ++i) {
+    const Pose pose = arcPose(i);
+    created += broken.addKeyframe(pose, {boxOf(lower, kBook, K, pose, i < 6 ? 1.0 : 0.4)}).new_objects;
+  }
+  broken.finish();
+  EXPECT_EQ(created, 2);  // the smaller boxes overlap the object's image too little to be tracked
+  const ObjectMap one = broken.map();
+  ASSERT_EQ(one.objects.size(), 1u);
+  EXPECT_EQ(broken.objects()[0].observations, 12);
+  EXPECT_LT((one.objects[0].ellipsoid.center() - lower.center()).norm(), 0.05);
 }
 
 // The map records where its keyframes were taken: their heights and tilts along the world's up

@@ -125,7 +125,8 @@ class Mapper {
   struct Track {
     int id = 0;
     VoxelObject voxels;
-    std::vector<BoxView> views;  // boxes mode
+    std::vector<BoxView> views;       // boxes mode
+    std::vector<int> keyframes_seen;  // boxes mode: the keyframes that detected it, ascending
     std::map<int, double> labels;
     int observations = 0;
     int last_seen = -1;
