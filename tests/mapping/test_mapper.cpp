@@ -199,7 +199,8 @@ Detection boxOf(const Ellipsoid& e, int category, const Intrinsics& K, const Pos
   const Projection p = project(e, K, pose);
   EXPECT_TRUE(p);
   const Box b = p.ellipse.boundingBox();
-  const Eigen::Vector2d c(0.5 * (b.x1 + b.x2), 0.5 * (b.y1 + b.y2)), h(0.5 * scale * b.width(), 0.5 * scale * b.height());
+  const Eigen::Vector2d c(0.5 * (b.x1 + b.x2), 0.5 * (b.y1 + b.y2));
+  const Eigen::Vector2d h(0.5 * scale * b.width(), 0.5 * scale * b.height());
   Detection d;
   d.category_id = category;
   d.bbox = Box(c.x() - h.x(), c.y() - h.y(), c.x() + h.x(), c.y() + h.y());
@@ -219,8 +220,9 @@ Pose arcPose(int i) {
 TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
   const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   const int kBook = 73;
-  const Ellipsoid lower(Eigen::Vector3d(0, 0, 0.02), Eigen::Vector3d(0.12, 0.09, 0.02), Eigen::Matrix3d::Identity());
-  const Ellipsoid upper(Eigen::Vector3d(0.01, 0.01, 0.06), Eigen::Vector3d(0.1, 0.08, 0.02), Eigen::Matrix3d::Identity());
+  const Eigen::Matrix3d level = Eigen::Matrix3d::Identity();
+  const Ellipsoid lower(Eigen::Vector3d(0, 0, 0.02), Eigen::Vector3d(0.12, 0.09, 0.02), level);
+  const Ellipsoid upper(Eigen::Vector3d(0.01, 0.01, 0.06), Eigen::Vector3d(0.1, 0.08, 0.02), level);
   MapperOptions options;
   options.mode = MappingMode::Boxes;
   Mapper stacked(K, options);
