@@ -19,6 +19,21 @@ bool boxFinite(const Box& b) {
   return std::isfinite(b.x1) && std::isfinite(b.y1) && std::isfinite(b.x2) && std::isfinite(b.y2);
 }
 
+/// Two boxes of one image are two objects (Mapper::mergeDuplicateBoxTracks), unless a detector
+/// without per-category suppression reported one object twice: a box that nearly coincides with
+/// a more confident one of its category (or an equal one listed first) is that second report.
+bool reportedTwice(const std::vector<Detection>& detections, size_t j) {
+  constexpr double kSameObjectIoU = 0.8;  // above the usual suppression thresholds (0.45-0.7)
+  const Detection& d = detections[j];
+  for (size_t k = 0; k < detections.size(); ++k) {
+    const Detection& other = detections[k];
+    if (k == j || other.category_id != d.category_id) continue;
+    const bool preferred = other.score > d.score || (other.score == d.score && k < j);
+    if (preferred && boxIoU(other.bbox, d.bbox) >= kSameObjectIoU) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 const char* toString(MappingMode mode) { return mode == MappingMode::Voxel ? "voxel" : "boxes"; }
@@ -322,7 +337,8 @@ std::vector<int> Mapper::associate2D(const std::vector<std::pair<size_t, Box>>& 
 void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report) {
   std::vector<size_t> used;
   for (size_t j = 0; j < detections.size(); ++j) {
-    if (detections[j].score < options_.min_score || !(detections[j].bbox.area() > 1.0)) {
+    if (detections[j].score < options_.min_score || !(detections[j].bbox.area() > 1.0) ||
+        reportedTwice(detections, j)) {
       ++report->ignored;
       continue;
     }

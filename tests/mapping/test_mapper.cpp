@@ -216,7 +216,8 @@ Pose arcPose(int i) {
 // Boxes mode: two objects of one label whose centres lie within the smaller one's mean
 // semi-axis (a book lying on another) stay two objects when keyframes detected both, since a
 // detector gives one box per object; an object whose track broke (its boxes suddenly much
-// smaller, as if half hidden, so that tracking started again) is joined again.
+// smaller, as if half hidden, so that tracking started again) is joined again; and an object a
+// detector reports twice (two nearly equal boxes) is one.
 TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
   const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   const int kBook = 73;
@@ -249,6 +250,21 @@ TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
   ASSERT_EQ(one.objects.size(), 1u);
   EXPECT_EQ(broken.objects()[0].observations, 12);
   EXPECT_LT((one.objects[0].ellipsoid.center() - lower.center()).norm(), 0.05);
+
+  Mapper twice(K, options);
+  int ignored = 0;
+  for (int i = 0; i < 12; ++i) {
+    const Pose pose = arcPose(i);
+    Detection first = boxOf(lower, kBook, K, pose), second = first;
+    first.score = 0.6;
+    second.score = 0.9;
+    second.bbox.x1 += 2.0;  // the same object, boxed a little differently
+    ignored += twice.addKeyframe(pose, {first, second}).ignored;
+  }
+  twice.finish();
+  EXPECT_EQ(ignored, 12);  // the less confident report of each keyframe
+  ASSERT_EQ(twice.map().objects.size(), 1u);
+  EXPECT_LT((twice.map().objects[0].ellipsoid.center() - lower.center()).norm(), 0.05);
 }
 
 // The map records where its keyframes were taken: their heights and tilts along the world's up
