@@ -67,6 +67,15 @@ std::string invalidInput(const Intrinsics& K, const std::optional<GravityPrior>&
   return bad_option.empty() ? "" : "invalid options: " + bad_option;
 }
 
+/// What every hypothesis of a frame must pass, prepared once: a tilt within max(gate_deg, 5
+/// sigma) of the gravity prior, and the camera envelope.
+PoseGate frameGate(const std::optional<GravityPrior>& gravity, const RelocalizerOptions& options) {
+  PoseGate gate;
+  if (gravity) gate.gravity = gravity->bound(std::max(options.gravity.gate_deg, 5.0 * gravity->sigma_deg));
+  if (options.envelope) gate.envelope = options.envelope->prepared();
+  return gate;
+}
+
 }  // namespace
 
 ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
@@ -187,9 +196,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   // 2. Hypotheses into the pool: triplets, then pairs when the frame has few observations or
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
-  PoseGate gate;
-  if (gravity) gate.gravity = gravity->bound(std::max(options_.gravity.gate_deg, 5.0 * gravity->sigma_deg));
-  if (options_.envelope) gate.envelope = options_.envelope->prepared();
+  const PoseGate gate = frameGate(gravity, options_);
   HypothesisPool pool(options_.refinement.top_k);
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;
