@@ -107,8 +107,8 @@ bool fitEllipsoid(const Intrinsics& K, const std::vector<BoxView>& views, const 
       delete cost;
       continue;
     }
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BoxW2Cost, 6, 3, 3, 3>(cost), new ceres::HuberLoss(0.5), c,
-                             s, w);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BoxW2Cost, 6, 3, 3, 3>(cost),
+                             new ceres::CauchyLoss(options.loss_scale), c, s, w);
   }
   if (problem.NumResidualBlocks() < static_cast<int>(std::max<size_t>(options.min_views, 2))) {
     out->status = BoxEllipsoidStatus::TooFewViews;
@@ -210,6 +210,10 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
   BoxEllipsoidResult out;
   if (!K.isValid()) {
     out.reason = "invalid intrinsics";
+    return out;
+  }
+  if (!(options.loss_scale > 0.0) || !std::isfinite(options.loss_scale)) {
+    out.reason = "loss_scale is not a positive number";
     return out;
   }
   std::vector<BoxView> valid, inside;

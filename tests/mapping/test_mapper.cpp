@@ -354,6 +354,7 @@ TEST(Mapper, OptionsOutOfRangeAreRefusedNamingTheField) {
   EXPECT_NE(problem([](MapperOptions& o) { o.prune_probability = INFINITY; }).find("prune_probability"),
             std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.max_views = 1; }).find("boxes.max_views"), std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.boxes.loss_scale = 0.0; }).find("boxes.loss_scale"), std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.up = Eigen::Vector3d::Zero(); }).find("boxes.up"),
             std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.min_score = NAN; }).find("min_score"), std::string::npos);

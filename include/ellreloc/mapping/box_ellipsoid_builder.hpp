@@ -57,6 +57,11 @@ struct BoxEllipsoidOptions {
   /// At most this many views enter the fit, evenly spread over the given order (time), which
   /// bounds the cost of a fit for an object seen in thousands of frames.
   size_t max_views = 60;
+  /// Scale of the Cauchy loss on each view's residual (the W2 between the box-inscribed
+  /// ellipse and the projection, over the box's size): a box that disagrees with the others by
+  /// more than about this (a detector's box of a part of the object, of an occluded or a
+  /// mis-associated one) weighs less and less, where a convex loss would let it pull the fit.
+  double loss_scale = 0.25;
   bool use_size_prior = true;
   /// When set (world coordinates, against gravity), the ellipsoid stands upright: its third
   /// axis is `up` and only its yaw is fitted, as the paper's RGB-D ellipsoids (PCA yaw).
