@@ -87,7 +87,7 @@ std::string MapperOptions::validate() const {
       {"boxes.min_median_iou", boxes.min_median_iou, 0, 1},
       {"boxes.max_iterations", double(boxes.max_iterations), 0, inf},
       {"boxes.max_views", double(boxes.max_views), double(boxes.min_views), inf},
-      {"boxes.loss_scale", boxes.loss_scale, 1e-6, inf},
+      {"boxes.loss_scale", boxes.loss_scale, 1e-6, 1e6},  // finite: the builder refuses others
       {"min_observations", double(min_observations), 1, inf},
       {"prune_probability", prune_probability, 0, 1},
       {"ellipsoid_min_probability", ellipsoid_min_probability, 0, 1},

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <atomic>
+#include <limits>
 #include <thread>
 
 #include "ellreloc/core/projection.hpp"
@@ -355,6 +356,9 @@ TEST(Mapper, OptionsOutOfRangeAreRefusedNamingTheField) {
             std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.max_views = 1; }).find("boxes.max_views"), std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.loss_scale = 0.0; }).find("boxes.loss_scale"), std::string::npos);
+  EXPECT_NE(problem([](MapperOptions& o) { o.boxes.loss_scale = std::numeric_limits<double>::infinity(); })
+                .find("boxes.loss_scale"),
+            std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.up = Eigen::Vector3d::Zero(); }).find("boxes.up"),
             std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.min_score = NAN; }).find("min_score"), std::string::npos);
