@@ -128,11 +128,12 @@ std::vector<ProjectableEllipsoid> prepare(const std::vector<EllipseMatch>& match
 }
 
 /// Sweeps poseAt(angle) (a ScoredPose with the sweep cost, or nullopt) over a full turn,
-/// refines the best local minima of the cost and returns them, best first.
+/// refines the best local minima of the cost and returns them, best first; with `bounds`, only
+/// those the refinement leaves within them.
 template <typename PoseAt>
 std::vector<ScoredPose> sweepAndRefine(const Intrinsics& K, const std::vector<EllipseMatch>& matches,
                                        const std::optional<GravityPrior>& gravity, const FewObjectOptions& opt,
-                                       PoseAt poseAt) {
+                                       const std::optional<CameraEnvelope::Prepared>& bounds, PoseAt poseAt) {
   const int steps = std::max(4, opt.angle_steps);
   std::vector<double> cost(static_cast<size_t>(steps), std::numeric_limits<double>::infinity());
   std::vector<Pose> pose(static_cast<size_t>(steps));
@@ -156,7 +157,8 @@ std::vector<ScoredPose> sweepAndRefine(const Intrinsics& K, const std::vector<El
       return (p.pose.center() - r.pose.center()).norm() < 0.01 &&
              rotationErrorDeg(p.pose.rotation(), r.pose.rotation()) < 0.5;
     });
-    if (!duplicate && r.pose.isValid()) out.push_back({r.pose, r.fell_back ? cost[k] : r.final_cost});
+    if (!duplicate && r.pose.isValid() && (!bounds || bounds->admits(r.pose)))
+      out.push_back({r.pose, r.fell_back ? cost[k] : r.final_cost});
   }
   std::sort(out.begin(), out.end(), [](const ScoredPose& x, const ScoredPose& y) { return x.cost < y.cost; });
   return out;
@@ -169,9 +171,12 @@ bool usable(const Intrinsics& K, const EllipseMatch& m) {
 }  // namespace
 
 std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
-                                            const std::optional<GravityPrior>& gravity,
-                                            const FewObjectOptions& options) {
-  if (!usable(K, a) || !usable(K, b) || (gravity && !gravity->isValid())) return {};
+                                            const std::optional<GravityPrior>& gravity, const FewObjectOptions& options,
+                                            const std::optional<CameraEnvelope>& envelope) {
+  if (!usable(K, a) || !usable(K, b) || (gravity && !gravity->isValid()) || (envelope && !envelope->isValid()))
+    return {};
+  std::optional<CameraEnvelope::Prepared> bounds;
+  if (envelope) bounds = envelope->prepared();
   const Eigen::Vector3d world_axis = b.ellipsoid.center() - a.ellipsoid.center();
   if (!(world_axis.norm() > 1e-9)) return {};
   // The segment between the centres lies, in the camera, in the plane of the two bearings,
@@ -206,7 +211,7 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
   std::vector<double> tilt_cost(aligns.size(), 0.0);
   std::vector<size_t> order(aligns.size());
   std::vector<Eigen::Matrix3d> shapes;
-  return sweepAndRefine(K, matches, gravity, options, [&](double angle) -> std::optional<ScoredPose> {
+  return sweepAndRefine(K, matches, gravity, options, bounds, [&](double angle) -> std::optional<ScoredPose> {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, w).toRotationMatrix();
     for (size_t i = 0; i < aligns.size(); ++i) {
       rotations[i] = aligns[i] * turn;
@@ -223,6 +228,9 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
     size_t best_index = 0;
     for (const size_t i : order) {
       if (best && (tilt_cost[i] > best->cost || (tilt_cost[i] == best->cost && i > best_index))) continue;
+      // Rotations outside the envelope's tilts and rolls are not placed: their minima would take
+      // the places of those within, for poses that mostly refine to outside it.
+      if (bounds && !bounds->admitsRotation(rotations[i])) continue;
       const std::optional<Pose> pose = placeAll(K, rotations[i], matches, prepared, &shapes);
       if (!pose) continue;
       const double cost = sweepCost(K, *pose, matches, prepared, shapes, gravity, options.refiner);
@@ -243,7 +251,7 @@ std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMat
   const std::vector<EllipseMatch> matches{a};
   const std::vector<ProjectableEllipsoid> prepared = prepare(matches);
   std::vector<Eigen::Matrix3d> shapes;
-  return sweepAndRefine(K, matches, gravity, options, [&](double yaw) -> std::optional<ScoredPose> {
+  return sweepAndRefine(K, matches, gravity, options, std::nullopt, [&](double yaw) -> std::optional<ScoredPose> {
     const std::optional<Pose> pose =
         placeAll(K, align * Eigen::AngleAxisd(yaw, up).toRotationMatrix(), matches, prepared, &shapes);
     if (!pose) return std::nullopt;

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/few_object_poses.hpp"
 #include "fixtures/random_geometry.hpp"
@@ -110,6 +112,70 @@ TEST(FewObjectPoses, TwoNoisyObjects) {
   std::sort(pos.begin(), pos.end());
   EXPECT_GE(first, 0.65 * trials);
   EXPECT_LT(pos[pos.size() / 2], 0.15);
+}
+
+TEST(FewObjectPoses, TwoObjectsKeepToACameraEnvelope) {
+  std::mt19937 rng(3);
+  const Intrinsics K = test::testIntrinsics();
+  int trials = 0, outside_without = 0, found_with = 0, found_without = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 2, 1.0, 0.03, &m)) continue;
+    ++trials;
+    // Up is the true camera's image-up: the truth is level, and an envelope of 30 degrees of
+    // tilt and 20 cm of height about it rules out most of the sweep's other minima.
+    CameraEnvelope envelope;
+    envelope.up = -truth.rotation().row(1).transpose();
+    envelope.max_tilt_deg = 30.0;
+    const double height = CameraEnvelope::heightOf(truth, envelope.up);
+    envelope.min_height = height - 0.2, envelope.max_height = height + 0.2;
+    const auto kept = posesFromTwoObjects(K, m[0], m[1], std::nullopt, {}, envelope);
+    const auto all = posesFromTwoObjects(K, m[0], m[1]);
+    for (const ScoredPose& p : kept) EXPECT_TRUE(envelope.admits(p.pose)) << "trial " << trial;
+    const auto outside = [&](const ScoredPose& p) { return !envelope.admits(p.pose); };
+    outside_without += std::any_of(all.begin(), all.end(), outside);
+    const auto near = [&](const std::vector<ScoredPose>& poses) {
+      return std::any_of(poses.begin(), poses.end(), [&](const ScoredPose& p) {
+        return positionError(p.pose, truth) < 0.15 && rotationError(p.pose, truth) < 5.0;
+      });
+    };
+    found_with += near(kept);
+    found_without += near(all);
+  }
+  // Measured (1 px, 3%, as TwoNoisyObjects): without the envelope 93 of 100 trials return a
+  // pose outside it; a pose within 15 cm / 5 deg of the truth is among those returned in 71 of
+  // 100 either way. (Placements are rough before their refinement: had the sweep also dropped
+  // those outside the heights, a start in the true pose's basin would have been lost once.)
+  EXPECT_GE(outside_without, 0.8 * trials);
+  EXPECT_GE(found_with, found_without);
+  EXPECT_GE(found_with, 0.65 * trials);
+}
+
+TEST(FewObjectPoses, AnEnvelopeThatAdmitsEverythingChangesNothing) {
+  std::mt19937 rng(5);
+  const Intrinsics K = test::testIntrinsics();
+  CameraEnvelope anywhere;  // every height, tilt and roll
+  int compared = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const Pose truth = test::randomLookAtPose(rng);
+    std::vector<EllipseMatch> m;
+    if (!observe(rng, truth, 2, 1.0, 0.03, &m)) continue;
+    const auto with = posesFromTwoObjects(K, m[0], m[1], std::nullopt, {}, anywhere);
+    const auto without = posesFromTwoObjects(K, m[0], m[1]);
+    ASSERT_EQ(with.size(), without.size());
+    for (size_t i = 0; i < with.size(); ++i) {
+      EXPECT_EQ(with[i].cost, without[i].cost);
+      EXPECT_EQ(with[i].pose.translation(), without[i].pose.translation());
+    }
+    ++compared;
+  }
+  EXPECT_GT(compared, 20);
+  CameraEnvelope invalid;
+  invalid.up = Eigen::Vector3d(0.0, 0.0, 2.0);  // not unit length
+  std::vector<EllipseMatch> m;
+  ASSERT_TRUE(observe(rng, test::randomLookAtPose(rng), 2, 0.0, 0.0, &m));
+  EXPECT_TRUE(posesFromTwoObjects(K, m[0], m[1], std::nullopt, {}, invalid).empty());
 }
 
 TEST(FewObjectPoses, OneObjectAndGravityGiveThePose) {

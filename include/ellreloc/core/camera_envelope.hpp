@@ -50,9 +50,14 @@ struct CameraEnvelope {
     double min_up_cos, max_up_cos;  // image-up . up: cos(max_tilt) .. cos(min_tilt)
     double max_right_sin;           // |image-right . up| <= sin(max_roll); above 1 without a bound
     bool admits(const Pose& pose) const {
-      const double h = heightOf(pose, up), c = -pose.rotation().row(1).dot(up);
-      return h >= min_height && h <= max_height && c >= min_up_cos && c <= max_up_cos &&
-             std::abs(pose.rotation().row(0).dot(up)) <= max_right_sin;
+      const double h = heightOf(pose, up);
+      return h >= min_height && h <= max_height && admitsRotation(pose.rotation());
+    }
+    /// The tilt and roll bounds alone, for a world->camera rotation whose translation is not
+    /// known yet.
+    bool admitsRotation(const Eigen::Matrix3d& R_cw) const {
+      const double c = -R_cw.row(1).dot(up);
+      return c >= min_up_cos && c <= max_up_cos && std::abs(R_cw.row(0).dot(up)) <= max_right_sin;
     }
   };
   Prepared prepared() const {

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ellreloc/core/camera.hpp"
+#include "ellreloc/core/camera_envelope.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
@@ -41,10 +42,15 @@ struct FewObjectOptions {
 
 /// Poses from two ellipse-ellipsoid correspondences (distinct ellipsoid centres), optionally
 /// constrained by gravity. Each pose's cost is the refiner's robust cost there (normalised W2,
-/// plus gravity).
+/// plus gravity). With a camera `envelope`, every pose returned lies within it, and the sweep
+/// places only rotations within its tilt and roll bounds: they are neither refined nor take
+/// the places of the `max_poses` minima from rotations within. (Heights are checked after the
+/// refinement only: a placement before it can be tens of centimetres off.) An invalid envelope
+/// gives no pose.
 std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
                                             const std::optional<GravityPrior>& gravity = std::nullopt,
-                                            const FewObjectOptions& options = {});
+                                            const FewObjectOptions& options = {},
+                                            const std::optional<CameraEnvelope>& envelope = std::nullopt);
 
 /// Poses from one ellipse-ellipsoid correspondence and gravity.
 std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMatch& a, const GravityPrior& gravity,

@@ -134,7 +134,8 @@ void HypothesisEstimator::fromTwoPairs(int a, int b, const std::optional<Gravity
                                        std::vector<Model>* out) const {
   const int own[2] = {a, b};
   fromSolver(posesFromTwoObjects(K_, ellipseMatchOf(pairs_[a], observations_, map_),
-                                 ellipseMatchOf(pairs_[b], observations_, map_), gravity, options_.few_objects.solver),
+                                 ellipseMatchOf(pairs_[b], observations_, map_), gravity, options_.few_objects.solver,
+                                 options_.envelope),
              own, 2, out);
 }
 
