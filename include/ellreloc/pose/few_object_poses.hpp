@@ -43,10 +43,10 @@ struct FewObjectOptions {
 /// Poses from two ellipse-ellipsoid correspondences (distinct ellipsoid centres), optionally
 /// constrained by gravity. Each pose's cost is the refiner's robust cost there (normalised W2,
 /// plus gravity). With a camera `envelope`, every pose returned lies within it, and the sweep
-/// places only rotations within its tilt and roll bounds: they are neither refined nor take
-/// the places of the `max_poses` minima from rotations within. (Heights are checked after the
-/// refinement only: a placement before it can be tens of centimetres off.) An invalid envelope
-/// gives no pose.
+/// places only rotations within its tilt and roll bounds, so that those outside are neither
+/// refined nor take the places of the `max_poses` minima of those within. (Heights are checked
+/// after the refinement only: a placement before it can be tens of centimetres off.) An
+/// invalid envelope gives no pose.
 std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
                                             const std::optional<GravityPrior>& gravity = std::nullopt,
                                             const FewObjectOptions& options = {},
