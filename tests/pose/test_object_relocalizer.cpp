@@ -724,7 +724,8 @@ TEST(CameraEnvelope, RollBoundsTheHorizon) {
   EXPECT_FALSE(bad.isValid());
 }
 
-// admits() tests cosines and a sine prepared once; it says what the angles say, at any pose.
+// admits() tests cosines and a sine prepared once; it says what the angles say, at any pose, and
+// admitsRotation() what the tilt and roll say.
 TEST(CameraEnvelope, AdmitsWhatItsAnglesAndHeightsSay) {
   CameraEnvelope e;
   e.up = Eigen::Vector3d(0.3, -0.2, 1.0).normalized();
@@ -745,6 +746,8 @@ TEST(CameraEnvelope, AdmitsWhatItsAnglesAndHeightsSay) {
     if (near(h, 0.5) || near(h, 1.8) || near(t, 10.0) || near(t, 70.0) || near(r, 30.0)) continue;
     const bool inside = h >= 0.5 && h <= 1.8 && t >= 10.0 && t <= 70.0 && r <= 30.0;
     EXPECT_EQ(e.admits(pose), inside) << "height " << h << " tilt " << t << " roll " << r;
+    // The rotation alone: the tilt and roll bounds, whatever the height.
+    EXPECT_EQ(e.prepared().admitsRotation(R), t >= 10.0 && t <= 70.0 && r <= 30.0) << "tilt " << t << " roll " << r;
     admitted += inside;
     ++compared;
   }
