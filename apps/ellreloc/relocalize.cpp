@@ -267,12 +267,18 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                        {"object_id", map.objects[static_cast<size_t>(c.object)].id},
                        {"overlap", c.overlap}});
   j["matches"] = matches;
-  j["rival"] = nullptr;
-  if (r.rival) {  // camera->world, as a TUM line has it
-    const Pose camera_to_world = r.rival->inverse();
+  const auto pose_json = [](const Pose& world_to_camera) {  // camera->world, as a TUM line has it
+    const Pose camera_to_world = world_to_camera.inverse();
     const Eigen::Vector3d& c = camera_to_world.translation();
     const Eigen::Quaterniond q(camera_to_world.rotation());
-    j["rival"] = {{"position", {c.x(), c.y(), c.z()}}, {"quaternion", {q.x(), q.y(), q.z(), q.w()}}};
+    return nlohmann::json{{"position", {c.x(), c.y(), c.z()}}, {"quaternion", {q.x(), q.y(), q.z(), q.w()}}};
+  };
+  j["rival"] = r.rival ? pose_json(*r.rival) : nlohmann::json();
+  j["alternatives"] = nlohmann::json::array();
+  for (const ScoredPose& a : r.alternatives) {
+    nlohmann::json alternative = pose_json(a.pose);
+    alternative["score"] = a.cost;
+    j["alternatives"].push_back(alternative);
   }
   if (reference) {
     j["reference"] = {{"score", ref.given.cost},
@@ -282,6 +288,13 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                       {"refined_moved_cm", poseError(ref.refined.pose, *reference).position_cm},
                       {"diagnosis", diagnosis}};
     if (r.rival) j["reference"]["rival_valid"] = poseError(*r.rival, *reference).valid();
+    // The first valid alternative, the one a host checking them in turn would stop at.
+    j["reference"]["valid_alternative"] = nlohmann::json();
+    for (size_t k = 0; k < r.alternatives.size(); ++k)
+      if (poseError(r.alternatives[k].pose, *reference).valid()) {
+        j["reference"]["valid_alternative"] = k;
+        break;
+      }
   }
   return j;
 }

@@ -533,6 +533,7 @@ class RelocalizationResult:
     cost: float
     margin: float
     rival: Optional[Pose]
+    alternatives: list[tuple[Pose, float]]
     mean_overlap: float
     skipped: list[tuple[int, str]]
     hypotheses: int

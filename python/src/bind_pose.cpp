@@ -354,6 +354,17 @@ void bindResult(py::module_& m) {
           "rival", [](const RelocalizationResult& r) { return hasPose(r) ? r.rival : std::nullopt; },
           "The best refined pose that is another answer (30 cm or 30 degrees away; world->camera), whose cost is "
           "`margin` higher, or None: a host that checks poses with its points can try it when `pose` fails.")
+      .def_property_readonly(
+          "alternatives",
+          [](const RelocalizationResult& r) {
+            std::vector<std::pair<Pose, double>> out;
+            if (hasPose(r))
+              for (const ScoredPose& a : r.alternatives) out.emplace_back(a.pose, a.cost);
+            return out;
+          },
+          "Every other answer among the refined hypotheses as (pose, cost), cheapest first, each 30 cm or 30 "
+          "degrees away from `pose` and from every cheaper one (the first is `rival`): the poses to check in turn "
+          "when `pose` fails.")
       .def_readonly("mean_overlap", &RelocalizationResult::mean_overlap)
       .def_readonly("skipped", &RelocalizationResult::skipped, "(observation index, reason) of observations not used")
       .def_readonly("hypotheses", &RelocalizationResult::hypotheses)

@@ -56,6 +56,10 @@ def test_a_margin_withholds_ambiguous_poses(fr2):
             assert b.rival is not None  # the other answer, for a host that checks poses with points
             apart = E.pose_error(b.rival, b.pose)
             assert apart.position_cm >= 30 or apart.rotation_deg >= 30
+            # The rival is the first of the other answers, cheapest first, the first costing `margin` more.
+            first, cost = b.alternatives[0]
+            assert np.array_equal(first.T_wc, b.rival.T_wc) and abs(cost - b.cost - b.margin) < 1e-9
+            assert [c for _, c in b.alternatives] == sorted(c for _, c in b.alternatives)
             withheld += 1
         else:
             assert b.status == a.status

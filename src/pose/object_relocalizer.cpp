@@ -236,7 +236,8 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   result.cost = chosen.cost;
   result.refined = chosen.refined;
   result.margin = chosen.margin;
-  result.rival = chosen.rival;
+  result.alternatives = chosen.alternatives;
+  if (!result.alternatives.empty()) result.rival = result.alternatives.front().pose;
   reportMatches(chosen.matches, usable, options_.acceptance, &result);
   const int min_inliers = usable == 1 ? 1 : options_.scoring.min_inliers;  // one observation needs gravity (above)
   if (static_cast<int>(chosen.matches.size()) < min_inliers)

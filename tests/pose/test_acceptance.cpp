@@ -18,6 +18,45 @@ using namespace ellreloc;
 
 namespace {
 
+/// A layout of `count` random ellipsoids on a 2.4 m x 2.4 m table-top, of `categories` categories.
+ObjectMap randomLayout(std::mt19937& rng, int count, int categories) {
+  ObjectMap map;
+  for (int i = 0; i < count; ++i)
+    map.objects.push_back({i, i % categories, "",
+                           Ellipsoid({test::uniform(rng, -1.2, 1.2), test::uniform(rng, -1.2, 1.2),
+                                      test::uniform(rng, -0.3, 0.3)},
+                                     {test::uniform(rng, 0.05, 0.25), test::uniform(rng, 0.05, 0.25),
+                                      test::uniform(rng, 0.05, 0.25)},
+                                     test::randomRotation(rng))});
+  return map;
+}
+
+/// `layout` `copies` times, copy k moved by k x `shift`, its ids + 100 k.
+ObjectMap repeatedLayout(const ObjectMap& layout, const Eigen::Vector3d& shift, int copies) {
+  ObjectMap map;
+  for (int k = 0; k < copies; ++k)
+    for (MapObject copy : layout.objects) {
+      copy.id += 100 * k;
+      copy.ellipsoid = Ellipsoid(copy.ellipsoid.center() + k * shift, copy.ellipsoid.axes(), copy.ellipsoid.rotation());
+      map.objects.push_back(copy);
+    }
+  return map;
+}
+
+/// A random layout and a view of it that sees at least five of its objects.
+struct LayoutView {
+  ObjectMap layout;
+  Pose truth;
+  std::vector<Observation> observations;
+};
+LayoutView viewOfRandomLayout(std::mt19937& rng, const Intrinsics& K, int count, int categories) {
+  for (;;) {
+    LayoutView v{randomLayout(rng, count, categories), test::randomLookAtPose(rng), {}};
+    v.observations = sim::observeMap(v.layout, K, v.truth);
+    if (v.observations.size() >= 5) return v;
+  }
+}
+
 /// Box observations of every detection of each frame.
 std::vector<std::vector<Observation>> boxObservations(const std::vector<DetectionFrame>& frames, const Intrinsics& K) {
   std::vector<std::vector<Observation>> out;
@@ -108,33 +147,15 @@ TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
   std::mt19937 rng(7);
   const Intrinsics K = test::testIntrinsics();
   const Eigen::Vector3d shift(20.0, 0.0, 0.0);
-  int tried = 0;
-  while (tried < 5) {
-    ObjectMap map;
-    for (int i = 0; i < 8; ++i)
-      map.objects.push_back({i, i % 4, "",
-                             Ellipsoid({test::uniform(rng, -1.2, 1.2), test::uniform(rng, -1.2, 1.2),
-                                        test::uniform(rng, -0.3, 0.3)},
-                                       {test::uniform(rng, 0.05, 0.25), test::uniform(rng, 0.05, 0.25),
-                                        test::uniform(rng, 0.05, 0.25)},
-                                       test::randomRotation(rng))});
-    const Pose truth = test::randomLookAtPose(rng);
-    const std::vector<Observation> observations = sim::observeMap(map, K, truth);
-    if (observations.size() < 5) continue;
-    ++tried;
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto [map, truth, observations] = viewOfRandomLayout(rng, K, 8, 4);
 
     const RelocalizationResult alone = ObjectRelocalizer(map, K).relocalize(observations);
     ASSERT_EQ(alone.status, RelocalizationStatus::Success) << alone.reason;
     EXPECT_LT(test::positionError(alone.pose, truth), 0.01);
     EXPECT_GT(alone.margin, 1.0);  // a rival pose explains at most a few observations, poorly
 
-    ObjectMap twins = map;
-    for (const MapObject& m : map.objects) {
-      MapObject copy = m;
-      copy.id += 100;
-      copy.ellipsoid = Ellipsoid(m.ellipsoid.center() + shift, m.ellipsoid.axes(), m.ellipsoid.rotation());
-      twins.objects.push_back(copy);
-    }
+    const ObjectMap twins = repeatedLayout(map, shift, 2);
     const Pose shifted(truth.rotation(), truth.translation() - truth.rotation() * shift);  // the same view of the copy
     // Every triplet, so that both copies' views are found whatever the sampler's stopping rule
     // (the twin map doubles the candidates: beyond the exhaustive search's default bound).
@@ -159,5 +180,49 @@ TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
     EXPECT_NE(withheld.reason.find("margin"), std::string::npos) << withheld.reason;
     EXPECT_TRUE(withheld.pose.isValid());
     EXPECT_EQ(ObjectRelocalizer(map, K, strict).relocalize(observations).status, RelocalizationStatus::Success);
+  }
+}
+
+// The alternatives: with the layout three times, 20 m apart, the other two copies' views are the
+// other answers, each once however many starts refined to it, cheapest first, the rival first.
+TEST(Acceptance, EachOtherCopyOfALayoutIsOneAlternative) {
+  std::mt19937 rng(11);
+  const Intrinsics K = test::testIntrinsics();
+  const Eigen::Vector3d shift(20.0, 0.0, 0.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    const auto [first_copy, truth, observations] = viewOfRandomLayout(rng, K, 6, 3);
+    const ObjectMap map = repeatedLayout(first_copy, shift, 3);
+
+    RelocalizerOptions every_triplet;
+    every_triplet.search.sampler = HypothesisSampler::Exhaustive;
+    const RelocalizationResult r = ObjectRelocalizer(map, K, every_triplet).relocalize(observations);
+    ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
+    std::vector<Pose> views;  // the same view of each copy
+    for (int copy = 0; copy < 3; ++copy)
+      views.emplace_back(truth.rotation(), truth.translation() - truth.rotation() * (copy * shift));
+    const auto copyOf = [&](const Pose& p) {
+      for (int copy = 0; copy < 3; ++copy)
+        if (test::positionError(p, views[static_cast<size_t>(copy)]) < 0.01 &&
+            test::rotationError(p, views[static_cast<size_t>(copy)]) < 0.5)
+          return copy;
+      return -1;
+    };
+    const int chosen = copyOf(r.pose);
+    ASSERT_GE(chosen, 0);
+    ASSERT_EQ(r.alternatives.size(), 2u);
+    const int a = copyOf(r.alternatives[0].pose), b = copyOf(r.alternatives[1].pose);
+    EXPECT_GE(a, 0);
+    EXPECT_GE(b, 0);
+    EXPECT_TRUE(a != chosen && b != chosen && a != b);
+    EXPECT_LE(r.alternatives[0].cost, r.alternatives[1].cost);
+    EXPECT_NEAR(r.margin, r.alternatives[0].cost - r.cost, 1e-12);
+    ASSERT_TRUE(r.rival);
+    EXPECT_EQ(r.rival->translation(), r.alternatives[0].pose.translation());
+
+    // The layout alone: any other answer explains the frame far worse.
+    const RelocalizationResult alone = ObjectRelocalizer(first_copy, K).relocalize(observations);
+    ASSERT_EQ(alone.status, RelocalizationStatus::Success) << alone.reason;
+    for (const ScoredPose& other : alone.alternatives) EXPECT_GT(other.cost - alone.cost, 1.0);
+    EXPECT_EQ(alone.rival.has_value(), !alone.alternatives.empty());
   }
 }

@@ -29,6 +29,7 @@
 #include "ellreloc/core/map_up.hpp"
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/core/observation.hpp"
+#include "ellreloc/core/pose.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
 
@@ -76,8 +77,13 @@ struct RelocalizationResult {
   /// is then too high.
   double margin = std::numeric_limits<double>::infinity();
   /// That rival's pose (world->camera), when there was one: a host that checks poses with its
-  /// points can try it when `pose` fails the check.
+  /// points can try it when `pose` fails the check. The first of `alternatives`.
   std::optional<Pose> rival;
+  /// Every other answer among the hypotheses refined (world->camera poses and their costs),
+  /// cheapest first: each at least kValidPositionCm or kValidRotationDeg away from the pose and
+  /// from every cheaper one. For a host that checks poses with its points, the ones to try in
+  /// turn when `pose` fails; empty when `rival` is none.
+  std::vector<ScoredPose> alternatives;
   std::vector<std::pair<int, std::string>> skipped;  ///< observations not used, with the reason
   long hypotheses = 0;
   int iterations = 0;

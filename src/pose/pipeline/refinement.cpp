@@ -1,5 +1,6 @@
 #include "refinement.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <thread>
 
@@ -91,14 +92,20 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
       best.matches = candidate.matches;  // refineRounds' matches are its pose's
     }
   // A rival that refines to another answer almost as well means look-alike objects or a
-  // symmetric layout: the frame cannot tell the two apart.
-  for (const ChosenPose& candidate : refined) {
-    const bool elsewhere = !poseError(candidate.pose, best.pose).valid();  // another answer
-    if (elsewhere && candidate.cost - best.cost < best.margin) {
-      best.margin = candidate.cost - best.cost;
-      best.rival = candidate.pose;
-    }
+  // symmetric layout: the frame cannot tell the two apart. Starts that refine to the same
+  // answer count once, at the cost of the cheapest.
+  std::vector<const ChosenPose*> by_cost;
+  for (const ChosenPose& candidate : refined) by_cost.push_back(&candidate);
+  std::stable_sort(by_cost.begin(), by_cost.end(),
+                   [](const ChosenPose* a, const ChosenPose* b) { return a->cost < b->cost; });
+  const auto elsewhere = [](const Pose& a, const Pose& b) { return !poseError(a, b).valid(); };  // another answer
+  for (const ChosenPose* candidate : by_cost) {
+    if (!elsewhere(candidate->pose, best.pose)) continue;
+    const bool seen = std::any_of(best.alternatives.begin(), best.alternatives.end(),
+                                  [&](const ScoredPose& a) { return !elsewhere(candidate->pose, a.pose); });
+    if (!seen) best.alternatives.push_back({candidate->pose, candidate->cost});
   }
+  if (!best.alternatives.empty()) best.margin = best.alternatives.front().cost - best.cost;
   return best;
 }
 

@@ -18,9 +18,10 @@ struct ChosenPose {
   double cost = 0.0;
   std::vector<ObjectCorrespondence> matches;
   bool refined = false;
-  /// The best other refined start whose pose is a different answer (kValidPositionCm or
-  /// kValidRotationDeg away), and its cost less this pose's (infinity when no start was).
-  std::optional<Pose> rival;
+  /// The other answers the refined starts reached, cheapest first, each kValidPositionCm or
+  /// kValidRotationDeg away from this pose and from every cheaper one; the cost of the first
+  /// less this pose's (infinity when there is none).
+  std::vector<ScoredPose> alternatives;
   double margin = std::numeric_limits<double>::infinity();
 };
 
@@ -40,8 +41,8 @@ ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementC
 
 /// Starts from `search_best` (the search's best pose) and refines the pooled hypotheses within
 /// refinement.cost_margin of the pool's best, at most `max_refined`, best first; returns the
-/// lowest-cost result, with its margin over the best refined start that lands elsewhere. The
-/// refinements run on one thread per scorer (the same result).
+/// lowest-cost result, with the other answers the refined starts reached and its margin over
+/// the best of them. The refinements run on one thread per scorer (the same result).
 ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
                             const std::vector<PoseScorer*>& scorers, const RefinementContext& context,
                             size_t max_refined);
