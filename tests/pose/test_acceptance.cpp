@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "ellreloc/core/evaluation.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/map.hpp"
@@ -21,13 +22,14 @@ namespace {
 /// A layout of `count` random ellipsoids on a 2.4 m x 2.4 m table-top, of `categories` categories.
 ObjectMap randomLayout(std::mt19937& rng, int count, int categories) {
   ObjectMap map;
-  for (int i = 0; i < count; ++i)
-    map.objects.push_back({i, i % categories, "",
-                           Ellipsoid({test::uniform(rng, -1.2, 1.2), test::uniform(rng, -1.2, 1.2),
-                                      test::uniform(rng, -0.3, 0.3)},
-                                     {test::uniform(rng, 0.05, 0.25), test::uniform(rng, 0.05, 0.25),
-                                      test::uniform(rng, 0.05, 0.25)},
-                                     test::randomRotation(rng))});
+  for (int i = 0; i < count; ++i) {
+    // One draw per statement: the order of a call's arguments is the compiler's to choose.
+    Eigen::Vector3d centre, axes;
+    for (int k = 0; k < 3; ++k) centre(k) = test::uniform(rng, k < 2 ? -1.2 : -0.3, k < 2 ? 1.2 : 0.3);
+    for (int k = 0; k < 3; ++k) axes(k) = test::uniform(rng, 0.05, 0.25);
+    const Eigen::Matrix3d rotation = test::randomRotation(rng);
+    map.objects.push_back({i, i % categories, "", Ellipsoid(centre, axes, rotation)});
+  }
   return map;
 }
 
@@ -209,12 +211,20 @@ TEST(Acceptance, EachOtherCopyOfALayoutIsOneAlternative) {
     };
     const int chosen = copyOf(r.pose);
     ASSERT_GE(chosen, 0);
-    ASSERT_EQ(r.alternatives.size(), 2u);
+    // The other two copies' views cost what the pose costs and come first; answers that explain
+    // the frame worse (look-alikes within one copy) may follow.
+    ASSERT_GE(r.alternatives.size(), 2u);
     const int a = copyOf(r.alternatives[0].pose), b = copyOf(r.alternatives[1].pose);
     EXPECT_GE(a, 0);
     EXPECT_GE(b, 0);
     EXPECT_TRUE(a != chosen && b != chosen && a != b);
-    EXPECT_LE(r.alternatives[0].cost, r.alternatives[1].cost);
+    for (size_t k = 0; k < r.alternatives.size(); ++k) {
+      EXPECT_FALSE(poseError(r.alternatives[k].pose, r.pose).valid()) << k;
+      for (size_t m = 0; m < k; ++m) {
+        EXPECT_FALSE(poseError(r.alternatives[k].pose, r.alternatives[m].pose).valid()) << k << " " << m;
+        EXPECT_LE(r.alternatives[m].cost, r.alternatives[k].cost);
+      }
+    }
     EXPECT_NEAR(r.margin, r.alternatives[0].cost - r.cost, 1e-12);
     ASSERT_TRUE(r.rival);
     EXPECT_EQ(r.rival->translation(), r.alternatives[0].pose.translation());
