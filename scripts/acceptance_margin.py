@@ -76,7 +76,8 @@ def main():
                                                            100.0 * passed / null_frames, " | ".join(cells),
                                                            total_valid, total_wrong))
         print()
-        print("| real set, every pose reported | frames | pose valid | pose or rival valid | pose or an alternative valid |")
+        print("| real set, every pose reported | frames | pose valid | pose or rival valid "
+              "| pose or an alternative valid |")
         print("|---|---|---|---|---|")
         for label, camera, map_path, frames, truth in real:
             entries = report(camera, map_path, frames, work, ["--reference", truth, "--accept-all"])

@@ -396,7 +396,8 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                            "/keyframes.detections.json --camera-up 0,0,0 --map-up 0,0,1"},
       {"camera up without map up",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --camera-up 0,-1,0"},
-      {"map up alone", reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --map-up 0,0,1"},
+      {"map up alone",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --map-up 0,0,1"},
       {"max tilt without map up",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --max-tilt 90"},
       {"max tilt of zero", reloc + "--map " + d + "/map.json --detections " + d +
