@@ -38,6 +38,12 @@ int main(int argc, char** argv) try {
               frames[index].file_name.c_str(), c(0), c(1), c(2), r.inliers.size(), observations.size(), r.time_ms);
   for (const ObjectCorrespondence& m : r.inliers)
     std::printf("  observation %d -> object %d (overlap %.2f)\n", m.observation, map.objects[m.object].id, m.overlap);
+  // Other answers the frame allows (look-alike objects), cheapest first: the poses a system with
+  // points would check next if its check of r.pose failed.
+  for (const ScoredPose& other : r.alternatives) {
+    const Eigen::Vector3d o = other.pose.center();
+    std::printf("  or camera centre %.3f %.3f %.3f (cost %.2f more)\n", o(0), o(1), o(2), other.cost - r.cost);
+  }
   return 0;
 } catch (const Error& e) {
   std::fprintf(stderr, "ellreloc_minimal: %s\n", e.what());
