@@ -36,7 +36,8 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
   r->add_option("--method", a.method, "ours or oa-slam (the OA-SLAM baseline)")->capture_default_str();
   r->add_option("--policy", a.policy, "observation policy (default: solid for ours, bbox for oa-slam)");
   r->add_option("--out", a.out, "TUM poses of the relocalized frames")->required();
-  r->add_option("--report", a.report, "per-frame JSON report: status, inliers, score, time");
+  r->add_option("--report", a.report,
+                "per-frame JSON report: status, matches, score, margin, the other answers found (alternatives), time");
   r->add_option("--reference", a.reference,
                 "TUM poses to diagnose against (the ground truth, or another method's output): the report gives "
                 "each frame's reference pose score under our cost and, for a pose off by >= 30 cm or 30 deg, "
