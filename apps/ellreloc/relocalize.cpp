@@ -288,14 +288,14 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                       {"refined_inliers", ref.refined.inliers.size()},
                       {"refined_moved_cm", poseError(ref.refined.pose, *reference).position_cm},
                       {"diagnosis", diagnosis}};
-    if (r.rival) j["reference"]["rival_valid"] = poseError(*r.rival, *reference).valid();
-    // The first valid alternative, the one a host checking them in turn would stop at.
-    j["reference"]["valid_alternative"] = nlohmann::json();
-    for (size_t k = 0; k < r.alternatives.size(); ++k)
-      if (poseError(r.alternatives[k].pose, *reference).valid()) {
-        j["reference"]["valid_alternative"] = k;
-        break;
-      }
+    // The first valid alternative, the one a host checking them in turn would stop at; the
+    // rival is the first alternative.
+    size_t first_valid = 0;
+    while (first_valid < r.alternatives.size() && !poseError(r.alternatives[first_valid].pose, *reference).valid())
+      ++first_valid;
+    const bool any_valid = first_valid < r.alternatives.size();
+    j["reference"]["valid_alternative"] = any_valid ? nlohmann::json(first_valid) : nlohmann::json();
+    if (r.rival) j["reference"]["rival_valid"] = any_valid && first_valid == 0;
   }
   return j;
 }
