@@ -45,6 +45,11 @@ ObjectMap repeatedLayout(const ObjectMap& layout, const Eigen::Vector3d& shift, 
   return map;
 }
 
+/// The same view of copy k of repeatedLayout(layout, shift, ...) as `view` has of the layout.
+Pose viewOfCopy(const Pose& view, const Eigen::Vector3d& shift, int k) {
+  return Pose(view.rotation(), view.translation() - view.rotation() * (k * shift));
+}
+
 /// A random layout and a view of it that sees at least five of its objects.
 struct LayoutView {
   ObjectMap layout;
@@ -158,7 +163,7 @@ TEST(Acceptance, TwinLayoutsLeaveNoMargin) {
     EXPECT_GT(alone.margin, 1.0);  // a rival pose explains at most a few observations, poorly
 
     const ObjectMap twins = repeatedLayout(map, shift, 2);
-    const Pose shifted(truth.rotation(), truth.translation() - truth.rotation() * shift);  // the same view of the copy
+    const Pose shifted = viewOfCopy(truth, shift, 1);
     // Every triplet, so that both copies' views are found whatever the sampler's stopping rule
     // (the twin map doubles the candidates: beyond the exhaustive search's default bound).
     RelocalizerOptions every_triplet;
@@ -200,8 +205,7 @@ TEST(Acceptance, EachOtherCopyOfALayoutIsOneAlternative) {
     const RelocalizationResult r = ObjectRelocalizer(map, K, every_triplet).relocalize(observations);
     ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
     std::vector<Pose> views;  // the same view of each copy
-    for (int copy = 0; copy < 3; ++copy)
-      views.emplace_back(truth.rotation(), truth.translation() - truth.rotation() * (copy * shift));
+    for (int copy = 0; copy < 3; ++copy) views.push_back(viewOfCopy(truth, shift, copy));
     const auto copyOf = [&](const Pose& p) {
       for (int copy = 0; copy < 3; ++copy)
         if (test::positionError(p, views[static_cast<size_t>(copy)]) < 0.01 &&
