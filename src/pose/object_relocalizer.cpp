@@ -76,6 +76,29 @@ PoseGate frameGate(const std::optional<GravityPrior>& gravity, const Relocalizer
   return gate;
 }
 
+/// The observations in the canonical order (canonicalOrder) and that order: `order[k]` is the
+/// index in the order given of the k-th.
+struct CanonicalFrame {
+  std::vector<int> order;
+  std::vector<Observation> observations;
+};
+
+CanonicalFrame inCanonicalOrder(const std::vector<Observation>& given) {
+  CanonicalFrame frame{canonicalOrder(given), {}};
+  frame.observations.reserve(given.size());
+  for (const int i : frame.order) frame.observations.push_back(given[static_cast<size_t>(i)]);
+  return frame;
+}
+
+/// `result` with its observation indices (of the canonical order) as indices of the order given.
+RelocalizationResult inGivenOrder(RelocalizationResult result, const std::vector<int>& order) {
+  for (ObjectCorrespondence& m : result.inliers) m.observation = order[static_cast<size_t>(m.observation)];
+  for (auto& [index, reason] : result.skipped) index = order[static_cast<size_t>(index)];
+  std::stable_sort(result.skipped.begin(), result.skipped.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  return result;
+}
+
 }  // namespace
 
 ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
@@ -97,6 +120,18 @@ ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, Relocal
 
 RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>& observations,
                                                   const Pose& pose) const {
+  const CanonicalFrame frame = inCanonicalOrder(observations);
+  return inGivenOrder(scorePoseInOrder(frame.observations, pose), frame.order);
+}
+
+RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation>& observations,
+                                                   const Pose& start) const {
+  const CanonicalFrame frame = inCanonicalOrder(observations);
+  return inGivenOrder(refineFromInOrder(frame.observations, start), frame.order);
+}
+
+RelocalizationResult ObjectRelocalizer::scorePoseInOrder(const std::vector<Observation>& observations,
+                                                         const Pose& pose) const {
   RelocalizationResult result;
   result.pose = pose;
   const std::string invalid = invalidInput(K_, std::nullopt, options_);
@@ -118,10 +153,10 @@ RelocalizationResult ObjectRelocalizer::scorePose(const std::vector<Observation>
   return result;
 }
 
-RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation>& observations,
-                                                   const Pose& start) const {
+RelocalizationResult ObjectRelocalizer::refineFromInOrder(const std::vector<Observation>& observations,
+                                                          const Pose& start) const {
   if (!invalidInput(K_, std::nullopt, options_).empty() || !start.isValid())
-    return scorePose(observations, start);  // says why
+    return scorePoseInOrder(observations, start);  // says why
   std::vector<std::pair<int, std::string>> skipped;
   const Candidates candidates =
       collectCandidates(observations, map_, options_.scoring, options_.search.max_candidate_pairs, &skipped);
@@ -129,7 +164,7 @@ RelocalizationResult ObjectRelocalizer::refineFrom(const std::vector<Observation
   const std::optional<GravityPrior> no_gravity;
   const RefinementContext context{observations, map_, K_, options_, no_gravity, PoseGate{}};
   const ChosenPose refined = refineRounds(start, scorer, context);
-  RelocalizationResult result = scorePose(observations, refined.pose);
+  RelocalizationResult result = scorePoseInOrder(observations, refined.pose);
   result.refined = refined.refined;
   return result;
 }
@@ -160,6 +195,13 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations,
                                                    const std::vector<Keypoint>& keypoints,
                                                    const std::optional<GravityPrior>& gravity) const {
+  const CanonicalFrame frame = inCanonicalOrder(observations);
+  return inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity), frame.order);
+}
+
+RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Observation>& observations,
+                                                          const std::vector<Keypoint>& keypoints,
+                                                          const std::optional<GravityPrior>& gravity) const {
   const auto start = std::chrono::steady_clock::now();
   RelocalizationResult result;
   const auto finish = [&](RelocalizationStatus status, std::string reason) {

@@ -146,6 +146,15 @@ class ObjectRelocalizer {
   const std::optional<MapUp>& upFromObjects() const { return up_from_objects_; }
 
  private:
+  // The public calls above hand these the observations in a canonical order (detection score
+  // first), so that their results do not depend on the order a detector lists its detections
+  // in, and give the results' observation indices back in the order given.
+  RelocalizationResult relocalizeInOrder(const std::vector<Observation>& observations,
+                                         const std::vector<Keypoint>& keypoints,
+                                         const std::optional<GravityPrior>& gravity) const;
+  RelocalizationResult scorePoseInOrder(const std::vector<Observation>& observations, const Pose& pose) const;
+  RelocalizationResult refineFromInOrder(const std::vector<Observation>& observations, const Pose& start) const;
+
   ObjectMap map_;
   std::optional<MapUp> up_from_objects_;
   std::vector<std::string> left_out_;

@@ -1,6 +1,7 @@
 #include "candidates.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace ellreloc::pipeline {
@@ -18,7 +19,48 @@ double candidateShare(const Observation& o, const MapObject& m, const ScoringOpt
   return share;
 }
 
+/// A total order on doubles for sorting: numbers ascending, then NaN.
+int compareTotal(double a, double b) {
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) - std::isnan(b);
+  return (a > b) - (a < b);
+}
+
+/// Every field of an observation, as the canonical order compares them.
+using SortKey = std::array<double, 14>;
+SortKey sortKey(const Observation& o) {
+  const Box& b = o.box;
+  const Ellipse& e = o.ellipse;
+  return {-o.score,
+          static_cast<double>(o.category),
+          b.x1,
+          b.y1,
+          b.x2,
+          b.y2,
+          e.center()(0),
+          e.center()(1),
+          e.axes()(0),
+          e.axes()(1),
+          e.angle(),
+          static_cast<double>(o.source),
+          o.regular ? static_cast<double>(*o.regular) : -1.0,
+          static_cast<double>(o.truncated)};
+}
+
 }  // namespace
+
+std::vector<int> canonicalOrder(const std::vector<Observation>& observations) {
+  std::vector<SortKey> keys;
+  keys.reserve(observations.size());
+  for (const Observation& o : observations) keys.push_back(sortKey(o));
+  std::vector<int> order(observations.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    for (size_t k = 0; k < SortKey().size(); ++k)
+      if (const int c = compareTotal(keys[static_cast<size_t>(a)][k], keys[static_cast<size_t>(b)][k])) return c < 0;
+    return false;
+  });
+  return order;
+}
 
 double usableTriplets(const Candidates& candidates) {
   // The third elementary symmetric sum of the candidate counts, built one observation at a time.

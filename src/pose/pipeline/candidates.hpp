@@ -27,6 +27,12 @@ struct Candidates {
   int num_usable = 0;
 };
 
+/// The indices of `observations` in a canonical order: detection score, highest first, then
+/// category, box, ellipse and the rest of the observation (NaN last). The relocalizer works on
+/// the observations in this order, so that its result does not depend on the order a detector
+/// lists its detections in: ties among near-equal hypotheses are settled by it.
+std::vector<int> canonicalOrder(const std::vector<Observation>& observations);
+
 /// Triplets of pairs with three distinct observations: the triplets P3P is tried on (a triplet
 /// that repeats an object is dropped when generated). Counted, not enumerated.
 double usableTriplets(const Candidates& candidates);
