@@ -2,12 +2,12 @@
 """The "detection order" table of docs/benchmarks.md: how much a data set's valid share moves
 when only the order of each frame's detections changes.
 
-A relocalization is a function of the detections in the order given (docs/pose.md): ties among
-near-equal hypotheses are settled by that order. fr2_desk's YOLO boxes all have score 1.0, so
-its ties are many; a change to the relocalizer that moves fr2 by a frame or two is within this
-band, and is better judged by the mean over several orders. Each set is relocalized with its
-frames' detections in the given order (order 0) and in N - 1 seeded shuffles, ours by default,
-ours reporting every pose (`--accept-all`) and the OA-SLAM preset.
+Ties among near-equal hypotheses are settled by the order of the observations; fr2_desk's YOLO
+boxes all have score 1.0, so its ties are many. The relocalizer works on the observations in a
+canonical order (docs/pose.md), so no row should move: this checks it, and measures the band of
+a search whose result depends on the order. Each set is relocalized with its frames' detections
+in the given order (order 0) and in N - 1 seeded shuffles, ours by default, ours reporting every
+pose (`--accept-all`) and the OA-SLAM preset.
 
   fr2_desk keyframes   the real GOReloc map
   fr3 even/odd         map (`ellreloc map --mode boxes`) from the even frames of the fr3/long_office

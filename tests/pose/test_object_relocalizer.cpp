@@ -318,8 +318,6 @@ TEST(ObjectRelocalizer, DeterministicAndThreadSafe) {
   }
 }
 
-// search.threads splits one frame's triplet hypotheses over threads: the same result, to the
-// bit, as one thread (ours with PROSAC and enumeration, and the exhaustive preset).
 // A detector lists its detections in an order of its own: the same detections in another order
 // give the same result, down to the bit, with the indices of the order given. Look-alike objects
 // and equal detection scores make many near-equal hypotheses, whose ties the order would settle.
@@ -368,6 +366,8 @@ TEST(ObjectRelocalizer, TheOrderOfTheObservationsDoesNotMatter) {
   EXPECT_EQ(compared, 12);
 }
 
+// search.threads splits one frame's triplet hypotheses over threads: the same result, to the
+// bit, as one thread (ours with PROSAC and enumeration, and the exhaustive preset).
 TEST(ObjectRelocalizer, OneFrameOnThreadsGivesTheSerialResultThreadSafe) {
   std::mt19937 rng(86);
   const Intrinsics K = test::testIntrinsics();
