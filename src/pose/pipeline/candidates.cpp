@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 
 namespace ellreloc::pipeline {
 
@@ -19,11 +20,8 @@ double candidateShare(const Observation& o, const MapObject& m, const ScoringOpt
   return share;
 }
 
-/// A total order on doubles for sorting: numbers ascending, then NaN.
-int compareTotal(double a, double b) {
-  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) - std::isnan(b);
-  return (a > b) - (a < b);
-}
+/// A strict weak order on doubles for sorting: numbers ascending, then NaN.
+bool lessNanLast(double a, double b) { return !std::isnan(a) && (std::isnan(b) || a < b); }
 
 /// Every field of an observation, as the canonical order compares them.
 using SortKey = std::array<double, 14>;
@@ -53,11 +51,10 @@ std::vector<int> canonicalOrder(const std::vector<Observation>& observations) {
   keys.reserve(observations.size());
   for (const Observation& o : observations) keys.push_back(sortKey(o));
   std::vector<int> order(observations.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    for (size_t k = 0; k < SortKey().size(); ++k)
-      if (const int c = compareTotal(keys[static_cast<size_t>(a)][k], keys[static_cast<size_t>(b)][k])) return c < 0;
-    return false;
+    const SortKey &ka = keys[static_cast<size_t>(a)], &kb = keys[static_cast<size_t>(b)];
+    return std::lexicographical_compare(ka.begin(), ka.end(), kb.begin(), kb.end(), lessNanLast);
   });
   return order;
 }
