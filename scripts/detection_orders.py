@@ -22,6 +22,7 @@ import random
 import sys
 import tempfile
 
+from fr3_splits import splits  # noqa: E402
 from real_data import box_map, data, relocalize  # noqa: E402  (same arguments as real_data.py)
 
 orders = int(sys.argv[3]) if len(sys.argv) > 3 else 8
@@ -50,9 +51,9 @@ def main():
     print("| data | method | valid, given order | mean over %d orders | lowest - highest |" % orders)
     print("|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as work:
-        frames = json.load(open(os.path.join(fr3, "detections.json")))
+        _, mapping, query = splits(json.load(open(os.path.join(fr3, "detections.json"))))[0]  # even/odd
         fr3_map, fr3_query, _ = box_map(os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt"),
-                                        frames[0::2], frames[1::10], work, "evenodd")
+                                        mapping, query, work, "evenodd")
         sets = [("fr2_desk keyframes", os.path.join(fr2, "camera.yaml"), os.path.join(fr2, "map.json"),
                  os.path.join(fr2, "keyframes.detections.json"), os.path.join(fr2, "keyframes.groundtruth.txt")),
                 ("fr3 even/odd", os.path.join(fr3, "camera.yaml"), fr3_map, fr3_query,
