@@ -5,6 +5,7 @@
 #include <iterator>
 #include <limits>
 #include <mutex>
+#include <tuple>
 
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/error.hpp"
@@ -32,6 +33,20 @@ bool reportedTwice(const std::vector<Detection>& detections, size_t j) {
     if (preferred && boxIoU(other.bbox, d.bbox) >= kSameObjectIoU) return true;
   }
   return false;
+}
+
+/// The detections in a canonical order: detection score highest first, then category and box
+/// (stable for detections equal in all of them), so that which detection starts a track, and so
+/// the objects' ids, does not depend on the order a detector lists its boxes in. The keyframe is
+/// checked first: every value compared is finite.
+std::vector<Detection> inCanonicalOrder(const std::vector<Detection>& detections) {
+  const auto key = [](const Detection& d) {
+    return std::make_tuple(-d.score, d.category_id, d.bbox.x1, d.bbox.y1, d.bbox.x2, d.bbox.y2);
+  };
+  std::vector<Detection> ordered = detections;
+  std::stable_sort(ordered.begin(), ordered.end(),
+                   [&](const Detection& a, const Detection& b) { return key(a) < key(b); });
+  return ordered;
 }
 
 }  // namespace
@@ -152,10 +167,11 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
     floor.seed = options_.floor.seed + static_cast<uint64_t>(keyframes_);
     if (const auto plane = estimateFloor(K_, pose, *depth, floor)) floor_normal_sum_ += plane->inlier_share * plane->up;
   }
+  const std::vector<Detection> ordered = inCanonicalOrder(detections);
   if (options_.mode == MappingMode::Voxel)
-    addVoxelKeyframe(pose, detections, *depth, &report);
+    addVoxelKeyframe(pose, ordered, *depth, &report);
   else
-    addBoxKeyframe(pose, detections, &report);
+    addBoxKeyframe(pose, ordered, &report);
   // Forget candidates that were not seen again (false detections, passing clutter).
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
                                [&](const Track& t) {

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <atomic>
 #include <limits>
+#include <random>
 #include <thread>
 
 #include "ellreloc/core/projection.hpp"
@@ -268,6 +270,37 @@ TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
   EXPECT_LT((twice.map().objects[0].ellipsoid.center() - lower.center()).norm(), 0.05);
 }
 
+// The objects, their ids included, do not depend on the order a detector lists a keyframe's
+// boxes in, in either mode: the same keyframes with each one's detections shuffled give the
+// same objects to the bit.
+TEST(Mapper, TheOrderOfTheDetectionsDoesNotMatter) {
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Office, 3, 12, test::mappingNoise());
+  for (const MappingMode mode : {MappingMode::Boxes, MappingMode::Voxel}) {
+    MapperOptions options;
+    options.mode = mode;
+    Mapper given(seq.K, options), shuffled(seq.K, options);
+    std::mt19937 rng(5);
+    for (const auto& kf : seq.keyframes) {
+      given.addKeyframe(kf.pose, kf.detections, &kf.depth);
+      std::vector<Detection> reordered = kf.detections;
+      std::shuffle(reordered.begin(), reordered.end(), rng);
+      shuffled.addKeyframe(kf.pose, reordered, &kf.depth);
+    }
+    given.finish();
+    shuffled.finish();
+    const std::vector<MappedObject> a = given.objects(), b = shuffled.objects();
+    ASSERT_GE(a.size(), 5u) << toString(mode);
+    ASSERT_EQ(a.size(), b.size()) << toString(mode);
+    for (size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].object.id, b[i].object.id) << toString(mode);
+      EXPECT_EQ(a[i].object.category, b[i].object.category);
+      EXPECT_EQ(a[i].observations, b[i].observations);
+      EXPECT_EQ(a[i].object.ellipsoid.center(), b[i].object.ellipsoid.center());
+      EXPECT_EQ(a[i].object.ellipsoid.axes(), b[i].object.ellipsoid.axes());
+    }
+  }
+}
+
 // The map records where its keyframes were taken: their heights and tilts along the world's up
 // when the mapper has one (voxel mode, or boxes mode given `boxes.up`), else along their mean
 // image-up, widened by 1 m and 30 degrees; none before two keyframes.
@@ -356,8 +389,9 @@ TEST(Mapper, OptionsOutOfRangeAreRefusedNamingTheField) {
             std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.max_views = 1; }).find("boxes.max_views"), std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.loss_scale = 0.0; }).find("boxes.loss_scale"), std::string::npos);
-  EXPECT_NE(problem([](MapperOptions& o) { o.boxes.loss_scale = std::numeric_limits<double>::infinity(); })
-                .find("boxes.loss_scale"),
+  EXPECT_NE(problem([](MapperOptions& o) {
+              o.boxes.loss_scale = std::numeric_limits<double>::infinity();
+            }).find("boxes.loss_scale"),
             std::string::npos);
   EXPECT_NE(problem([](MapperOptions& o) { o.boxes.up = Eigen::Vector3d::Zero(); }).find("boxes.up"),
             std::string::npos);

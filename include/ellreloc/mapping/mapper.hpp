@@ -102,7 +102,9 @@ class Mapper {
   /// Adds a keyframe: world->camera pose, detections (boxes; masks in voxel mode), and the depth
   /// image in metres (voxel mode; ignored in boxes mode). Throws ellreloc::Error naming the
   /// problem for a non-finite pose, a missing, mis-sized or empty depth image, or a mask whose
-  /// size differs from the camera's; the map is then left unchanged.
+  /// size differs from the camera's; the map is then left unchanged. The detections are taken in
+  /// a canonical order (score highest first, then category and box): their order in the vector
+  /// changes nothing.
   KeyframeReport addKeyframe(const Pose& pose, const std::vector<Detection>& detections,
                              const DepthImage* depth = nullptr);
 
