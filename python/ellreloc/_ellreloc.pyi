@@ -658,6 +658,7 @@ class TrackingOptions:
     iou_weight: float
     min_iou: float
     min_iou_other_label: float
+    depth_margin: float
     match_radius: float
     match_ratio: float
 

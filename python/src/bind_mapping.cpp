@@ -65,6 +65,7 @@ void bindMapperOptions(py::module_& m) {
       .def_readwrite("iou_weight", &TrackingOptions::iou_weight)
       .def_readwrite("min_iou", &TrackingOptions::min_iou)
       .def_readwrite("min_iou_other_label", &TrackingOptions::min_iou_other_label)
+      .def_readwrite("depth_margin", &TrackingOptions::depth_margin)
       .def_readwrite("match_radius", &TrackingOptions::match_radius)
       .def_readwrite("match_ratio", &TrackingOptions::match_ratio);
   py::enum_<YawMethod>(m, "YawMethod")

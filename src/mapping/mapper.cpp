@@ -49,6 +49,36 @@ std::vector<Detection> inCanonicalOrder(const std::vector<Detection>& detections
   return ordered;
 }
 
+/// The 10th and 90th percentiles of the camera depths of an object's occupied voxels
+/// (world->camera pose): its depth range in a keyframe, with stray voxels (mask pixels on the
+/// background) left out.
+std::pair<double, double> depthRange(const VoxelObject& voxels, const Pose& pose) {
+  std::vector<double> z;
+  for (const Eigen::Vector3d& x : voxels.occupiedCentres()) z.push_back(pose.transform(x).z());
+  if (z.empty()) return {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  const auto at = [&](double q) {
+    const auto k = z.begin() + static_cast<long>(q * static_cast<double>(z.size() - 1));
+    std::nth_element(z.begin(), k, z.end());
+    return *k;
+  };
+  return {at(0.1), at(0.9)};
+}
+
+/// The median depth of a mask's pixels that have one (nullopt when none does).
+std::optional<double> medianDepth(const BinaryMask& mask, const DepthImage& depth) {
+  std::vector<float> z;
+  for (int y = 0; y < mask.height; ++y)
+    for (int x = 0; x < mask.width; ++x) {
+      const int u = mask.x0 + x, v = mask.y0 + y;
+      if (!mask.at(x, y) || u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
+      const float d = depth.at(u, v);
+      if (d > 0.0f && std::isfinite(d)) z.push_back(d);
+    }
+  if (z.empty()) return std::nullopt;
+  std::nth_element(z.begin(), z.begin() + static_cast<long>(z.size() / 2), z.end());
+  return z[z.size() / 2];
+}
+
 }  // namespace
 
 const char* toString(MappingMode mode) { return mode == MappingMode::Voxel ? "voxel" : "boxes"; }
@@ -91,6 +121,7 @@ std::string MapperOptions::validate() const {
       {"tracking.iou_weight", tracking.iou_weight, 0, inf},
       {"tracking.min_iou", tracking.min_iou, 0, 1},
       {"tracking.min_iou_other_label", tracking.min_iou_other_label, 0, 1},
+      {"tracking.depth_margin", tracking.depth_margin, 0, inf},
       {"tracking.match_radius", tracking.match_radius, 0, inf},
       {"tracking.match_ratio", tracking.match_ratio, 0, 1},
       {"ellipsoid.low_percentile", ellipsoid.low_percentile, 0, ellipsoid.high_percentile},
@@ -248,13 +279,26 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     masks.push_back(std::move(*mask));
   }
 
-  // 2D tracking against the objects seen in the last keyframes, by their projected voxels.
+  // 2D tracking against the objects seen in the last keyframes, by their projected voxels, of
+  // each detection with a mask only to objects whose depth range holds the mask's median depth.
   std::vector<std::pair<size_t, Box>> expected;
+  std::vector<std::pair<double, double>> depth_ranges;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (keyframes_ - tracks_[i].last_seen > options_.track_window) continue;
-    if (const auto box = tracks_[i].voxels.projectedBox(K_, pose)) expected.emplace_back(i, *box);
+    if (const auto box = tracks_[i].voxels.projectedBox(K_, pose)) {
+      expected.emplace_back(i, *box);
+      depth_ranges.push_back(depthRange(tracks_[i].voxels, pose));
+    }
   }
-  const std::vector<int> tracked = associate2D(expected, detections, used);
+  PairGate gate = PairGate::Constant(static_cast<long>(expected.size()), static_cast<long>(used.size()), true);
+  for (size_t k = 0; k < used.size(); ++k) {
+    const std::optional<double> z = detections[used[k]].mask ? medianDepth(masks[k], depth) : std::nullopt;
+    const double margin = options_.tracking.depth_margin;
+    for (size_t i = 0; i < expected.size() && z; ++i)
+      gate(static_cast<long>(i), static_cast<long>(k)) =
+          *z >= depth_ranges[i].first - margin && *z <= depth_ranges[i].second + margin;
+  }
+  const std::vector<int> tracked = associate2D(expected, detections, used, gate);
 
   for (size_t k = 0; k < used.size(); ++k) {
     const Detection& d = detections[used[k]];
@@ -341,11 +385,12 @@ void Mapper::mergeDuplicateVoxelTracks() {
 }
 
 std::vector<int> Mapper::associate2D(const std::vector<std::pair<size_t, Box>>& expected,
-                                     const std::vector<Detection>& detections, const std::vector<size_t>& used) const {
+                                     const std::vector<Detection>& detections, const std::vector<size_t>& used,
+                                     const PairGate& gate) const {
   std::vector<LabelledBox> object_boxes, detection_boxes;
   for (const auto& [track, box] : expected) object_boxes.push_back({box, tracks_[track].label()});
   for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id});
-  std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking);
+  std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking, gate);
   for (int& t : tracked)
     if (t >= 0) t = static_cast<int>(expected[static_cast<size_t>(t)].first);
   return tracked;

@@ -7,6 +7,7 @@
 #include <random>
 #include <thread>
 
+#include "ellreloc/core/mask.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
@@ -299,6 +300,79 @@ TEST(Mapper, TheOrderOfTheDetectionsDoesNotMatter) {
       EXPECT_EQ(a[i].object.ellipsoid.axes(), b[i].object.ellipsoid.axes());
     }
   }
+}
+
+/// A keyframe of squares (centre, half-size), each turned about the vertical so that its depth
+/// grows by half its sideways offset, seen by a camera at `eye` looking along +z: the depth
+/// image and, for each square in `detected`, a detection whose mask is the part of it in view
+/// (nearer squares hide farther ones).
+struct Squares {
+  std::vector<std::pair<Eigen::Vector3d, double>> squares;
+  DepthImage depth;
+  std::vector<Detection> detections;
+};
+Squares renderSquares(const Intrinsics& K, const Eigen::Vector3d& eye,
+                      const std::vector<std::pair<Eigen::Vector3d, double>>& squares, const std::vector<int>& detected,
+                      int category) {
+  Squares out{squares, {K.width, K.height, std::vector<float>(static_cast<size_t>(K.width * K.height), 0.0f)}, {}};
+  std::vector<BinaryMask> masks(squares.size(), BinaryMask(K.height, K.width));
+  for (int v = 0; v < K.height; ++v)
+    for (int u = 0; u < K.width; ++u) {
+      const double a = (u - K.cx) / K.fx, b = (v - K.cy) / K.fy;
+      int nearest = -1;
+      double nearest_z = 0.0;
+      for (size_t i = 0; i < squares.size(); ++i) {
+        const Eigen::Vector3d c = squares[i].first - eye;
+        const double z = (c.z() - 0.5 * c.x()) / (1.0 - 0.5 * a);  // the ray meets z = c_z + (x - c_x) / 2
+        const bool inside =
+            std::abs(a * z - c.x()) <= squares[i].second && std::abs(b * z - c.y()) <= squares[i].second;
+        if (inside && z > 0.0 && (nearest < 0 || z < nearest_z)) nearest = static_cast<int>(i), nearest_z = z;
+      }
+      if (nearest < 0) continue;
+      out.depth.metres[static_cast<size_t>(v * K.width + u)] = static_cast<float>(nearest_z);
+      masks[static_cast<size_t>(nearest)].data[static_cast<size_t>(v * K.width + u)] = 1;
+    }
+  for (const int i : detected) {
+    Detection d;
+    d.category_id = category;
+    d.mask = encodeMask(masks[static_cast<size_t>(i)]);
+    d.bbox = *maskBox(*d.mask);
+    out.detections.push_back(d);
+  }
+  return out;
+}
+
+// Voxel mode: a detection is tracked in 2D only to an object whose depth range in the keyframe
+// holds its mask's median depth. Two books 1 m apart in depth, the nearer one missed in a
+// keyframe; then the camera moves to where the nearer hides the farther: its detection overlaps
+// the farther one's expected box (the only object tracked from the keyframe before), but lies a
+// metre in front of it, so it is matched in 3D to its own object instead of joining the other.
+TEST(Mapper, ADetectionIsNotTrackedToAnObjectAtAnotherDepth) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const int kBook = 73;
+  const Eigen::Vector3d far(0.0, 0.0, 3.0), near(-0.5, 0.0, 2.0);  // in line with a camera at x = -1.5
+  const std::vector<std::pair<Eigen::Vector3d, double>> squares{{far, 0.1}, {near, 0.1}};
+  const Eigen::Vector3d start(0.0, 0.0, 0.0), behind(-1.5, 0.0, 0.0);
+  const std::vector<std::pair<Eigen::Vector3d, std::vector<int>>> keyframes{
+      {start, {0, 1}}, {start, {0, 1}}, {start, {0}}, {behind, {1}}, {behind, {1}}};
+  MapperOptions options;
+  options.ellipsoid.up = -Eigen::Vector3d::UnitY();  // the cameras' image-up
+  Mapper mapper(K, options);
+  for (const auto& [eye, detected] : keyframes) {
+    const Squares frame = renderSquares(K, eye, squares, detected, kBook);
+    const Pose pose(Eigen::Matrix3d::Identity(), -eye);  // world->camera, no rotation
+    mapper.addKeyframe(pose, frame.detections, &frame.depth);
+  }
+  const std::vector<MappedObject> objects = mapper.objects();
+  ASSERT_EQ(objects.size(), 2u);
+  for (const Eigen::Vector3d& truth : {far, near}) {
+    const auto at = std::find_if(objects.begin(), objects.end(), [&](const MappedObject& o) {
+      return (o.object.ellipsoid.center() - truth).norm() < 0.03;
+    });
+    ASSERT_NE(at, objects.end()) << truth.transpose();
+    EXPECT_LT(at->object.ellipsoid.axes().maxCoeff(), 0.15);  // one square, not both
+  }
+  EXPECT_EQ(objects[0].observations + objects[1].observations, 7);
 }
 
 // The map records where its keyframes were taken: their heights and tilts along the world's up

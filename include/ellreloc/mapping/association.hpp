@@ -12,6 +12,7 @@
 ///     n(v, v_i) > xi min(|v|, |v_i|)  and  n(v_i, v) > xi min(|v|, |v_i|),
 /// n(a, b) = voxels of a with a voxel of b within radius r.
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <vector>
 
@@ -28,6 +29,10 @@ struct TrackingOptions {
   /// A detection whose label differs from the object's joins it only with this much overlap
   /// (detectors confuse labels; the object's label is the most frequent one).
   double min_iou_other_label = 0.5;
+  /// Voxel mode, detections with a mask: the median depth of the mask's pixels must lie within
+  /// the object's depth range in the keyframe, widened by this much (metres), for 2D tracking to
+  /// pair them: two objects one behind the other overlap in the image, not in depth.
+  double depth_margin = 0.1;
   double match_radius = 0.05;  ///< r of eq. 4, metres
   double match_ratio = 0.5;    ///< xi of eq. 4
 };
@@ -38,10 +43,14 @@ struct LabelledBox {
   int label = 0;
 };
 
-/// 2D association: for each detection, the index of its map object or -1.
+/// Which object-detection pairs 2D association may keep (objects x detections); empty: all.
+using PairGate = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
+
+/// 2D association: for each detection, the index of its map object or -1. Pairs the gate rules
+/// out are never kept.
 inline std::vector<int> associateBoxes(const std::vector<LabelledBox>& objects,
-                                       const std::vector<LabelledBox>& detections,
-                                       const TrackingOptions& options = {}) {
+                                       const std::vector<LabelledBox>& detections, const TrackingOptions& options = {},
+                                       const PairGate& gate = {}) {
   std::vector<int> result(detections.size(), -1);
   if (objects.empty() || detections.empty()) return result;
   Eigen::MatrixXd cost(static_cast<long>(objects.size()), static_cast<long>(detections.size()));
@@ -50,9 +59,12 @@ inline std::vector<int> associateBoxes(const std::vector<LabelledBox>& objects,
     for (size_t j = 0; j < detections.size(); ++j) {
       const double o = boxIoU(objects[i].box, detections[j].box);
       const bool other_label = objects[i].label != detections[j].label;
-      iou(static_cast<long>(i), static_cast<long>(j)) = o;
+      const bool ruled_out = gate.size() > 0 && !gate(static_cast<long>(i), static_cast<long>(j));
+      iou(static_cast<long>(i), static_cast<long>(j)) = ruled_out ? 0.0 : o;
+      // A pair ruled out costs more than any other, so the assignment takes as few as it can.
       cost(static_cast<long>(i), static_cast<long>(j)) =
-          options.label_weight * (other_label ? 1.0 : 0.0) + options.iou_weight * (1.0 - o);
+          ruled_out ? 2.0 * (options.label_weight + options.iou_weight)
+                    : options.label_weight * (other_label ? 1.0 : 0.0) + options.iou_weight * (1.0 - o);
     }
   const std::vector<int> assignment = hungarianAssignment(cost);
   for (size_t i = 0; i < objects.size(); ++i) {
