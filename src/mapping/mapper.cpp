@@ -317,13 +317,13 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
       --report->used, ++report->ignored;  // no depth inside the mask
       continue;
     }
+    // Of several objects that pass it (neighbours of one label), the one that matches best.
     Track* match = nullptr;
+    double best = options_.tracking.match_ratio;
     for (Track& t : tracks_) {
       if (t.last_seen == keyframes_ || t.label() != d.category_id) continue;
-      if (voxelObjectsMatch(fresh, t.voxels, options_.tracking)) {
-        match = &t;
-        break;
-      }
+      const double strength = voxelMatchStrength(fresh, t.voxels, options_.tracking);
+      if (strength > best) best = strength, match = &t;
     }
     if (match != nullptr) {
       match->voxels.integrate(K_, pose, depth, masks[k]);

@@ -375,6 +375,34 @@ TEST(Mapper, ADetectionIsNotTrackedToAnObjectAtAnotherDepth) {
   EXPECT_EQ(objects[0].observations + objects[1].observations, 7);
 }
 
+// Voxel mode: a detection left over by 2D tracking joins the object its voxels match best, not
+// the first that passes eq. 4. Two small books side by side, 1 cm apart, both pass it for a
+// detection of the right one seen again after two keyframes without either; the left one was
+// mapped first.
+TEST(Mapper, ADetectionJoinsTheObjectItsVoxelsMatchBest) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const int kBook = 73;
+  const Eigen::Vector3d left(-0.035, 0.0, 2.0), right(0.035, 0.0, 2.0);
+  const std::vector<std::pair<Eigen::Vector3d, double>> squares{{left, 0.03}, {right, 0.03}};
+  const std::vector<std::vector<int>> keyframes{{0, 1}, {0, 1}, {0, 1}, {}, {}, {1}};
+  MapperOptions options;
+  options.ellipsoid.up = -Eigen::Vector3d::UnitY();  // the cameras' image-up
+  Mapper mapper(K, options);
+  int matched_3d = 0;
+  for (const std::vector<int>& detected : keyframes) {
+    const Squares frame = renderSquares(K, Eigen::Vector3d::Zero(), squares, detected, kBook);
+    matched_3d += mapper.addKeyframe(Pose(), frame.detections, &frame.depth).matched_3d;
+  }
+  EXPECT_EQ(matched_3d, 1);
+  const std::vector<MappedObject> objects = mapper.objects();
+  ASSERT_EQ(objects.size(), 2u);
+  for (const MappedObject& o : objects) {
+    const bool is_right = o.object.ellipsoid.center().x() > 0.0;
+    EXPECT_LT((o.object.ellipsoid.center() - (is_right ? right : left)).norm(), 0.015);
+    EXPECT_EQ(o.observations, is_right ? 4 : 3);
+  }
+}
+
 // The map records where its keyframes were taken: their heights and tilts along the world's up
 // when the mapper has one (voxel mode, or boxes mode given `boxes.up`), else along their mean
 // image-up, widened by 1 m and 30 degrees; none before two keyframes.

@@ -78,12 +78,18 @@ inline std::vector<int> associateBoxes(const std::vector<LabelledBox>& objects,
   return result;
 }
 
+/// How well a detection's voxels `v` match a map object's voxels `vi`: the smaller of n(v, v_i)
+/// and n(v_i, v) over min(|v|, |v_i|) (0 when either is empty), which eq. 4 compares with xi.
+inline double voxelMatchStrength(const VoxelObject& v, const VoxelObject& vi, const TrackingOptions& options = {}) {
+  const double smaller = static_cast<double>(std::min(v.occupiedCount(), vi.occupiedCount()));
+  if (smaller <= 0.0) return 0.0;
+  return static_cast<double>(std::min(v.countNear(vi, options.match_radius), vi.countNear(v, options.match_radius))) /
+         smaller;
+}
+
 /// 3D matching (eq. 4) of a detection's voxels `v` with a map object's voxels `vi`.
 inline bool voxelObjectsMatch(const VoxelObject& v, const VoxelObject& vi, const TrackingOptions& options = {}) {
-  const double smaller = static_cast<double>(std::min(v.occupiedCount(), vi.occupiedCount()));
-  if (smaller <= 0.0) return false;
-  return v.countNear(vi, options.match_radius) > options.match_ratio * smaller &&
-         vi.countNear(v, options.match_radius) > options.match_ratio * smaller;
+  return voxelMatchStrength(v, vi, options) > options.match_ratio;
 }
 
 }  // namespace ellreloc
