@@ -291,9 +291,9 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     }
   }
   PairGate gate = PairGate::Constant(static_cast<long>(expected.size()), static_cast<long>(used.size()), true);
+  const double margin = options_.tracking.depth_margin;
   for (size_t k = 0; k < used.size(); ++k) {
     const std::optional<double> z = detections[used[k]].mask ? medianDepth(masks[k], depth) : std::nullopt;
-    const double margin = options_.tracking.depth_margin;
     for (size_t i = 0; i < expected.size() && z; ++i)
       gate(static_cast<long>(i), static_cast<long>(k)) =
           *z >= depth_ranges[i].first - margin && *z <= depth_ranges[i].second + margin;
