@@ -4,6 +4,7 @@
 #include <numeric>
 #include <random>
 
+#include "ellreloc/mapping/association.hpp"
 #include "ellreloc/mapping/hungarian.hpp"
 
 namespace ellreloc {
@@ -58,6 +59,38 @@ TEST(Hungarian, EmptyAndObviousCases) {
   Eigen::MatrixXd C(3, 3);
   C << 9, 1, 9, 1, 9, 9, 9, 9, 1;
   EXPECT_EQ(hungarianAssignment(C), std::vector<int>({1, 0, 2}));
+}
+
+// 2D association (the paper's tracking cost): the pairs of highest IoU, a label mismatch only at
+// IoU >= 0.5, nothing below 0.2.
+TEST(AssociateBoxes, FollowsOverlapAndLabels) {
+  const int kCup = 41, kBook = 73;
+  const std::vector<LabelledBox> objects{
+      {Box(0, 0, 100, 100), kCup}, {Box(200, 0, 300, 100), kCup}, {Box(400, 0, 500, 100), kBook}};
+  const std::vector<LabelledBox> detections{
+      {Box(205, 5, 305, 105), kCup},  // object 1 (IoU 0.82)
+      {Box(10, 10, 110, 110), kCup},  // object 0 (IoU 0.68)
+      {Box(430, 0, 530, 100), kCup},  // the book's box at IoU 0.54: another label, overlapping enough
+      {Box(600, 0, 700, 100), kCup},  // nothing there
+  };
+  EXPECT_EQ(associateBoxes(objects, detections), std::vector<int>({1, 0, 2, -1}));
+  std::vector<LabelledBox> weak = detections;
+  weak[2].box = Box(450, 0, 550, 100);  // IoU 0.33 with the book: too little for another label
+  EXPECT_EQ(associateBoxes(objects, weak), std::vector<int>({1, 0, -1, -1}));
+}
+
+// A pair the gate rules out is never kept; the assignment then gives the detection to the
+// object it may join, if their boxes overlap enough.
+TEST(AssociateBoxes, AGateRulesPairsOut) {
+  const int kBottle = 39;
+  const std::vector<LabelledBox> objects{{Box(100, 100, 140, 200), kBottle}, {Box(110, 100, 150, 200), kBottle}};
+  const std::vector<LabelledBox> detections{{Box(100, 100, 140, 200), kBottle}};  // object 0's box exactly
+  EXPECT_EQ(associateBoxes(objects, detections), std::vector<int>({0}));
+  PairGate gate = PairGate::Constant(2, 1, true);
+  gate(0, 0) = false;                                                               // e.g. a metre apart in depth
+  EXPECT_EQ(associateBoxes(objects, detections, {}, gate), std::vector<int>({1}));  // IoU 0.6
+  gate(1, 0) = false;
+  EXPECT_EQ(associateBoxes(objects, detections, {}, gate), std::vector<int>({-1}));
 }
 
 }  // namespace
