@@ -195,19 +195,22 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations,
                                                    const std::vector<Keypoint>& keypoints,
                                                    const std::optional<GravityPrior>& gravity) const {
+  const auto start = std::chrono::steady_clock::now();  // the frame's clock: its time budget and time_ms
   const CanonicalFrame frame = inCanonicalOrder(observations);
-  return inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity), frame.order);
+  RelocalizationResult result =
+      inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity, start), frame.order);
+  result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
 }
 
 RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Observation>& observations,
                                                           const std::vector<Keypoint>& keypoints,
-                                                          const std::optional<GravityPrior>& gravity) const {
-  const auto start = std::chrono::steady_clock::now();
+                                                          const std::optional<GravityPrior>& gravity,
+                                                          std::chrono::steady_clock::time_point start) const {
   RelocalizationResult result;
   const auto finish = [&](RelocalizationStatus status, std::string reason) {
     result.status = status;
     result.reason = std::move(reason);
-    result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
   const std::string invalid = invalidInput(K_, gravity, options_);

@@ -19,6 +19,7 @@
 /// A gravity prior drops every hypothesis whose tilt disagrees with it and lets a single
 /// observation give poses.
 
+#include <chrono>
 #include <limits>
 #include <optional>
 #include <string>
@@ -151,7 +152,8 @@ class ObjectRelocalizer {
   // in, and give the results' observation indices back in the order given.
   RelocalizationResult relocalizeInOrder(const std::vector<Observation>& observations,
                                          const std::vector<Keypoint>& keypoints,
-                                         const std::optional<GravityPrior>& gravity) const;
+                                         const std::optional<GravityPrior>& gravity,
+                                         std::chrono::steady_clock::time_point start) const;
   RelocalizationResult scorePoseInOrder(const std::vector<Observation>& observations, const Pose& pose) const;
   RelocalizationResult refineFromInOrder(const std::vector<Observation>& observations, const Pose& start) const;
 
