@@ -307,14 +307,13 @@ TEST(Mapper, TheOrderOfTheDetectionsDoesNotMatter) {
 /// image and, for each square in `detected`, a detection whose mask is the part of it in view
 /// (nearer squares hide farther ones).
 struct Squares {
-  std::vector<std::pair<Eigen::Vector3d, double>> squares;
   DepthImage depth;
   std::vector<Detection> detections;
 };
 Squares renderSquares(const Intrinsics& K, const Eigen::Vector3d& eye,
                       const std::vector<std::pair<Eigen::Vector3d, double>>& squares, const std::vector<int>& detected,
                       int category) {
-  Squares out{squares, {K.width, K.height, std::vector<float>(static_cast<size_t>(K.width * K.height), 0.0f)}, {}};
+  Squares out{{K.width, K.height, std::vector<float>(static_cast<size_t>(K.width * K.height), 0.0f)}, {}};
   std::vector<BinaryMask> masks(squares.size(), BinaryMask(K.height, K.width));
   for (int v = 0; v < K.height; ++v)
     for (int u = 0; u < K.width; ++u) {
