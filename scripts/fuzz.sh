@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 dir=build-asan
-targets=(fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer fuzz_image)
+targets=(fuzz_rle fuzz_json fuzz_text_files fuzz_geometry fuzz_relocalizer fuzz_image fuzz_mapper)
 [ -f "$dir/build.ninja" ] || scripts/sanitize.sh configure-asan
 cmake --build "$dir" -j "$(nproc)" --target "${targets[@]}"  # nothing to do when they are up to date
 mkdir -p "$dir/artifacts"

@@ -340,10 +340,11 @@ BinaryMask maskFromBox(const Box& box, int image_width, int image_height) {
   m.image_height = image_height;
   if (!box.isValid()) return m;  // empty: zero-sized crop
   // Pixel (x, y) covers [x - 0.5, x + 0.5]: it belongs to the box when its centre is inside.
-  const int x1 = static_cast<int>(std::max(0.0, std::ceil(box.x1)));
-  const int y1 = static_cast<int>(std::max(0.0, std::ceil(box.y1)));
-  const int x2 = static_cast<int>(std::min(image_width - 1.0, std::floor(box.x2)));
-  const int y2 = static_cast<int>(std::min(image_height - 1.0, std::floor(box.y2)));
+  // Clamped to the image before the cast: a box may lie far outside it (any finite number).
+  const auto pixel = [](double v, double lo, double hi) { return static_cast<int>(std::clamp(v, lo, hi)); };
+  const int x1 = pixel(std::ceil(box.x1), 0.0, image_width), y1 = pixel(std::ceil(box.y1), 0.0, image_height);
+  const int x2 = pixel(std::floor(box.x2), -1.0, image_width - 1.0);
+  const int y2 = pixel(std::floor(box.y2), -1.0, image_height - 1.0);
   if (x2 < x1 || y2 < y1) return m;
   m.x0 = x1;
   m.y0 = y1;

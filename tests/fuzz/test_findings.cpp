@@ -7,6 +7,7 @@
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/detections.hpp"
 #include "ellreloc/io/map.hpp"
+#include "ellreloc/mapping/voxel_object.hpp"
 #include "ellreloc/core/rle.hpp"
 
 namespace ellreloc {
@@ -37,6 +38,18 @@ TEST(FuzzFindings, DistancesOfHugeEllipsesAreInfiniteNotNaN) {
   EXPECT_FALSE(std::isnan(bhattacharyya(a, b)));
   EXPECT_FALSE(std::isnan(levelSetDistance(a, b, 4)));
   EXPECT_GE(wasserstein2(a, b), 0.0);
+}
+
+// A detection box far outside the image (finite, 8e136 pixels) overflowed the int cast of its
+// pixel bounds when voxel mapping took the box as the mask (undefined behaviour); it gives an
+// empty mask, and a box that only reaches past the image is cut to it.
+TEST(FuzzFindings, BoxMasksFarOutsideTheImageAreEmpty) {
+  EXPECT_EQ(maskFromBox(Box(8.2e136, 1.0, 9e136, 20.0), 64, 48).count(), 0);
+  EXPECT_EQ(maskFromBox(Box(-1e200, -1e200, -1e199, -1e199), 64, 48).count(), 0);
+  const BinaryMask cut = maskFromBox(Box(-1e200, 10.0, 1e200, 12.0), 64, 48);
+  EXPECT_EQ(cut.count(), 64 * 3);
+  EXPECT_EQ(cut.x0, 0);
+  EXPECT_EQ(cut.width, 64);
 }
 
 }  // namespace
