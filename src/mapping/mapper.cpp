@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "ellreloc/core/projection.hpp"
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/mapping/category_sizes.hpp"
 
@@ -51,32 +52,12 @@ std::vector<Detection> inCanonicalOrder(const std::vector<Detection>& detections
 
 /// The 10th and 90th percentiles of the camera depths of an object's occupied voxels
 /// (world->camera pose): its depth range in a keyframe, with stray voxels (mask pixels on the
-/// background) left out.
+/// background) left out; unbounded without voxels.
 std::pair<double, double> depthRange(const VoxelObject& voxels, const Pose& pose) {
   std::vector<double> z;
   for (const Eigen::Vector3d& x : voxels.occupiedCentres()) z.push_back(pose.transform(x).z());
-  if (z.empty()) return {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  const auto at = [&](double q) {
-    const auto k = z.begin() + static_cast<long>(q * static_cast<double>(z.size() - 1));
-    std::nth_element(z.begin(), k, z.end());
-    return *k;
-  };
-  return {at(0.1), at(0.9)};
-}
-
-/// The median depth of a mask's pixels that have one (nullopt when none does).
-std::optional<double> medianDepth(const BinaryMask& mask, const DepthImage& depth) {
-  std::vector<float> z;
-  for (int y = 0; y < mask.height; ++y)
-    for (int x = 0; x < mask.width; ++x) {
-      const int u = mask.x0 + x, v = mask.y0 + y;
-      if (!mask.at(x, y) || u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
-      const float d = depth.at(u, v);
-      if (d > 0.0f && std::isfinite(d)) z.push_back(d);
-    }
-  if (z.empty()) return std::nullopt;
-  std::nth_element(z.begin(), z.begin() + static_cast<long>(z.size() / 2), z.end());
-  return z[z.size() / 2];
+  const double inf = std::numeric_limits<double>::infinity();
+  return {quantile(z, 0.1, -inf), quantile(z, 0.9, inf)};
 }
 
 }  // namespace
@@ -293,10 +274,15 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
   PairGate gate = PairGate::Constant(static_cast<long>(expected.size()), static_cast<long>(used.size()), true);
   const double margin = options_.tracking.depth_margin;
   for (size_t k = 0; k < used.size(); ++k) {
-    const std::optional<double> z = detections[used[k]].mask ? medianDepth(masks[k], depth) : std::nullopt;
-    for (size_t i = 0; i < expected.size() && z; ++i)
+    if (!detections[used[k]].mask) continue;  // a box as the mask holds the background too
+    // Every positive finite reading: the median only places the detection in depth.
+    const std::vector<double> readings =
+        maskDepths(depth, masks[k], 1, std::numeric_limits<double>::denorm_min(), std::numeric_limits<double>::max());
+    if (readings.empty()) continue;
+    const double z = median(readings);
+    for (size_t i = 0; i < expected.size(); ++i)
       gate(static_cast<long>(i), static_cast<long>(k)) =
-          *z >= depth_ranges[i].first - margin && *z <= depth_ranges[i].second + margin;
+          z >= depth_ranges[i].first - margin && z <= depth_ranges[i].second + margin;
   }
   const std::vector<int> tracked = associate2D(expected, detections, used, gate);
 

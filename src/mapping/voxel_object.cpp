@@ -51,16 +51,22 @@ BinaryMask majorityFiltered(const BinaryMask& mask) {
   return out;
 }
 
-std::pair<double, double> VoxelObject::depthGate(const DepthImage& depth, const BinaryMask& mask, int stride) const {
-  std::pair<double, double> range(options_.min_depth, options_.max_depth);
-  if (!(options_.depth_gate_sigmas > 0.0)) return range;
+std::vector<double> maskDepths(const DepthImage& depth, const BinaryMask& mask, int stride, double min_depth,
+                               double max_depth) {
   std::vector<double> d;
   for (int ly = 0; ly < mask.height; ly += stride)
     for (int lx = 0; lx < mask.width; lx += stride) {
       if (mask.at(lx, ly) == 0) continue;
       const double v = depth.at(lx + mask.x0, ly + mask.y0);
-      if (v >= options_.min_depth && v <= options_.max_depth) d.push_back(v);
+      if (v >= min_depth && v <= max_depth) d.push_back(v);
     }
+  return d;
+}
+
+std::pair<double, double> VoxelObject::depthGate(const DepthImage& depth, const BinaryMask& mask, int stride) const {
+  std::pair<double, double> range(options_.min_depth, options_.max_depth);
+  if (!(options_.depth_gate_sigmas > 0.0)) return range;
+  std::vector<double> d = maskDepths(depth, mask, stride, options_.min_depth, options_.max_depth);
   if (d.empty()) return range;
   const double centre = median(d);
   for (double& v : d) v = std::abs(v - centre);

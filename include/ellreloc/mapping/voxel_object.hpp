@@ -153,6 +153,11 @@ class VoxelObject {
 /// The mask after a 3x3 majority vote (5 of 9 pixels set), same crop.
 BinaryMask majorityFiltered(const BinaryMask& mask);
 
+/// The depth readings within [min_depth, max_depth] under a mask's pixels, of every `stride`-th
+/// row and column of its crop (the mask must lie within the depth image).
+std::vector<double> maskDepths(const DepthImage& depth, const BinaryMask& mask, int stride, double min_depth,
+                               double max_depth);
+
 /// A mask covering a box (the whole box is the object): for detectors without masks.
 BinaryMask maskFromBox(const Box& box, int image_width, int image_height);
 
