@@ -619,6 +619,7 @@ class SearchBudget:
     max_hypotheses: int
     max_time_ms: float
     success_probability: float
+    enough_extension: float
     seed: int
 
 
@@ -628,6 +629,8 @@ class SearchOptions:
     max_exhaustive_triplets: int
     correct_centres: bool
     check_sample_overlap: bool
+    stop_when_explained: bool
+    explained_mean_credit: float
     budget: SearchBudget
     max_overlap_evaluations: int
     max_candidate_pairs: int

@@ -167,6 +167,9 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("max_hypotheses", &RansacOptions::max_hypotheses)
       .def_readwrite("max_time_ms", &RansacOptions::max_time_ms, "wall-clock budget per frame; 0 = none")
       .def_readwrite("success_probability", &RansacOptions::success_probability)
+      .def_readwrite("enough_extension", &RansacOptions::enough_extension,
+                     "after a pose explaining every observation (search.stop_when_explained): this many times the "
+                     "samples drawn so far, then stop")
       .def_readwrite("seed", &RansacOptions::seed);
   py::class_<SearchOptions>(m, "SearchOptions")
       .def(py::init<>())
@@ -174,6 +177,10 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("max_exhaustive_triplets", &SearchOptions::max_exhaustive_triplets)
       .def_readwrite("correct_centres", &SearchOptions::correct_centres)
       .def_readwrite("check_sample_overlap", &SearchOptions::check_sample_overlap)
+      .def_readwrite("stop_when_explained", &SearchOptions::stop_when_explained,
+                     "end a sampled search once a pose explains every usable observation (at least four) well")
+      .def_readwrite("explained_mean_credit", &SearchOptions::explained_mean_credit,
+                     "the mean credit (overlap) such a pose needs")
       .def_readwrite("budget", &SearchOptions::budget)
       .def_readwrite("max_overlap_evaluations", &SearchOptions::max_overlap_evaluations)
       .def_readwrite("max_candidate_pairs", &SearchOptions::max_candidate_pairs)

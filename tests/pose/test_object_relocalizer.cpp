@@ -93,6 +93,31 @@ TEST(ObjectRelocalizer, ManyObjectsOfOneCategory) {
   EXPECT_GE(recovered, tried - 1);
 }
 
+// Among 12 cups every observation has 12 candidates, so the stopping rule, reading inliers over
+// all pairs, draws about 12,000 samples whatever the search found; a pose explaining every cup
+// in view ends the sampled search instead (after 400-4,000 samples here).
+TEST(ObjectRelocalizer, APoseExplainingEveryObservationEndsASampledSearch) {
+  std::mt19937 rng(87);
+  const Intrinsics K = test::testIntrinsics();
+  int tried = 0, shorter = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    const Synthetic s = makeScene(rng, 12, 1, 0.5);
+    if (s.observations.size() < 5) continue;
+    ++tried;
+    RelocalizerOptions full;
+    full.search.stop_when_explained = false;
+    const RelocalizationResult early = ObjectRelocalizer(s.map, K).relocalize(s.observations);
+    const RelocalizationResult all = ObjectRelocalizer(s.map, K, full).relocalize(s.observations);
+    EXPECT_LE(early.iterations, all.iterations);
+    shorter += early.iterations < all.iterations;
+    ASSERT_EQ(early.status, RelocalizationStatus::Success) << early.reason;
+    EXPECT_LT(positionError(early.pose, s.truth), 0.05);
+    EXPECT_EQ(early.inliers.size(), s.observations.size());
+  }
+  EXPECT_GE(tried, 4);
+  EXPECT_EQ(shorter, tried);
+}
+
 // Auto enumerates when the triplets of distinct observations are few, though the triplets of
 // candidate pairs are many: 4 observations with 6 candidates each form 864 usable triplets
 // (within max_exhaustive_triplets, 1000) among 2024 triplets of pairs. The result is then the
@@ -150,6 +175,12 @@ TEST(ObjectRelocalizer, InvalidOptionsGiveInvalidInputNamingTheField) {
   o = RelocalizerOptions();
   o.refinement.top_k = 0;
   expectRefused(o, "refinement.top_k");
+  o = RelocalizerOptions();
+  o.search.explained_mean_credit = 1.2;
+  expectRefused(o, "search.explained_mean_credit");
+  o = RelocalizerOptions();
+  o.search.budget.enough_extension = std::nan("");
+  expectRefused(o, "search.budget.enough_extension");
   o = RelocalizerOptions();
   o.refinement.regular_mask_sigma = 0.0;
   expectRefused(o, "refinement.regular_mask_sigma");
@@ -353,12 +384,14 @@ TEST(ObjectRelocalizer, TheOrderOfTheObservationsDoesNotMatter) {
     ASSERT_EQ(b.skipped.size(), 1u);
     EXPECT_EQ(order[static_cast<size_t>(b.skipped[0].first)], 2);
 
-    const RelocalizationResult scored_a = reloc.scorePose(given, s.truth), scored_b = reloc.scorePose(shuffled, s.truth);
+    const RelocalizationResult scored_a = reloc.scorePose(given, s.truth),
+                               scored_b = reloc.scorePose(shuffled, s.truth);
     EXPECT_EQ(scored_a.cost, scored_b.cost);
     ASSERT_EQ(scored_a.inliers.size(), scored_b.inliers.size());
     for (size_t k = 0; k < scored_a.inliers.size(); ++k)
       EXPECT_EQ(scored_a.inliers[k].observation, order[static_cast<size_t>(scored_b.inliers[k].observation)]);
-    const RelocalizationResult refined_a = reloc.refineFrom(given, a.pose), refined_b = reloc.refineFrom(shuffled, a.pose);
+    const RelocalizationResult refined_a = reloc.refineFrom(given, a.pose),
+                               refined_b = reloc.refineFrom(shuffled, a.pose);
     EXPECT_EQ(refined_a.pose.translation(), refined_b.pose.translation());
   }
 }
@@ -631,9 +664,9 @@ TEST(ObjectRelocalizer, RefinementMatchesArePairedAndWeighedAsTheRefinement) {
     EXPECT_TRUE(pairs[i].ellipsoid.center().isApprox(s.map.objects[c.object].ellipsoid.center()));
     EXPECT_DOUBLE_EQ(pairs[i].sigma, c.observation == 0 ? 0.25 : 1.0);
   }
-  const Pose start(Eigen::AngleAxisd(0.03, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() *
-                       s.truth.rotation(),
-                   s.truth.translation() + Eigen::Vector3d(0.05, -0.04, 0.03));
+  const Pose start(
+      Eigen::AngleAxisd(0.03, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() * s.truth.rotation(),
+      s.truth.translation() + Eigen::Vector3d(0.05, -0.04, 0.03));
   const Pose refined = refinePose(K, start, pairs, {}, options.refinement.refiner).pose;
   EXPECT_LT(positionError(refined, s.truth), 0.01);
   std::vector<ObjectCorrespondence> bad = at_truth.inliers;

@@ -38,6 +38,14 @@ struct RansacOptions {
   double max_time_ms = 0.0;             ///< wall-clock budget; 0 = none
   double success_probability = 0.9999;  ///< for the adaptive iteration count
   uint64_t seed = 0;                    ///< same input + seed = same output
+  /// A best model with at least `enough_inliers` inliers (a support no model can exceed, e.g.
+  /// every observation explained) and a score at most `enough_score` ends the search early:
+  /// `enough_extension` times as many samples again as had been drawn when it came, then stop,
+  /// whatever the adaptive count asks (the extra samples look for a model of the same support
+  /// that scores better). Off by default.
+  int enough_inliers = std::numeric_limits<int>::max();
+  double enough_score = -std::numeric_limits<double>::infinity();
+  double enough_extension = 1.0;
 };
 
 struct RansacStats {
@@ -269,13 +277,14 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
   RansacStats st;
   const size_t n = estimators.front()->numData();
   int needed = options.max_iterations;
+  int enough_stop = std::numeric_limits<int>::max();  // set once, by the first good enough best model
   bool have = false, sampler_done = false;
   while (true) {
     if (st.iterations >= options.max_iterations || st.hypotheses >= options.max_hypotheses) {
       st.budget_exhausted = true;
       break;
     }
-    const int stop_at = std::max(options.min_iterations, needed);
+    const int stop_at = std::max(options.min_iterations, std::min(needed, enough_stop));
     if (st.iterations >= stop_at) break;
     if (options.max_time_ms > 0.0 && (st.iterations & 7) == 0 &&
         std::chrono::duration<double, std::milli>(Clock::now() - start).count() > options.max_time_ms) {
@@ -314,6 +323,10 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
         have = true;
         needed = adaptiveIterations(n ? static_cast<double>(s.inliers[i]) / n : 0.0, Estimator::kSampleSize,
                                     options.success_probability);
+        if (enough_stop == std::numeric_limits<int>::max() && s.inliers[i] >= options.enough_inliers &&
+            s.scores[i] <= options.enough_score)
+          enough_stop = static_cast<int>(
+              std::min(std::ceil(st.iterations * (1.0 + options.enough_extension)), double(options.max_iterations)));
       }
     }
   }

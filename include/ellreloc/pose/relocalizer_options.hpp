@@ -42,6 +42,15 @@ struct SearchOptions {
   /// Drop a pose when one of its own three pairs overlaps less than scoring.min_overlap: a
   /// wrong triplet rarely fits the three shapes, and this costs three overlaps, not a map.
   bool check_sample_overlap = true;
+  /// A sampled search (Uniform, Prosac) ends early once its best hypothesis explains every
+  /// usable observation, at least four of them, with a mean credit (overlap, weighed by label as
+  /// the cost is: 1 - its cost per observation) of at least `explained_mean_credit`: it draws
+  /// as many samples again (budget.enough_extension) and stops: no pose can explain more,
+  /// and the adaptive count, reading inliers over every candidate pair, would go on as if at most
+  /// one pair in twelve could be right where each observation has twelve look-alike candidates.
+  /// Enumeration never stops early. (budget.enough_inliers and enough_score are set per frame.)
+  bool stop_when_explained = true;
+  double explained_mean_credit = 0.7;
   /// Sample and hypothesis budgets, adaptive stopping and seed. The Exhaustive sampler
   /// enumerates every triplet: only max_hypotheses and max_time_ms bound it.
   RansacOptions budget;
@@ -164,6 +173,7 @@ struct RelocalizerOptions {
     o.search.sampler = HypothesisSampler::Exhaustive;
     o.search.correct_centres = false;
     o.search.check_sample_overlap = false;
+    o.search.stop_when_explained = false;
     o.search.budget.max_hypotheses = 1L << 40;
     // The baseline enumerates everything real frames offer (at most 4.3e7 overlaps on fr2_desk
     // and fr3/long_office frames), but stays bounded on absurd input.
@@ -192,6 +202,10 @@ struct RelocalizerOptions {
       return "search.budget.max_time_ms is negative or not finite";
     if (!(search.budget.success_probability > 0 && search.budget.success_probability < 1))
       return "search.budget.success_probability is not in (0, 1)";
+    if (!(search.budget.enough_extension >= 0 && search.budget.enough_extension <= 1e6))
+      return "search.budget.enough_extension is not in [0, 1e6]";
+    if (!(search.explained_mean_credit >= 0 && search.explained_mean_credit <= 1))
+      return "search.explained_mean_credit is not in [0, 1]";
     if (search.max_overlap_evaluations < 0) return "search.max_overlap_evaluations is negative";
     if (search.max_candidate_pairs < 1) return "search.max_candidate_pairs is below 1";
     if (search.threads < 1 || search.threads > 256) return "search.threads is not in [1, 256]";

@@ -37,6 +37,17 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
     budget.max_time_ms = frame.max_time_ms - frame.elapsedMs();
     if (budget.max_time_ms <= 0.0) budget.max_hypotheses = 0, budget.max_time_ms = 1e-9;
   }
+  // The adaptive count reads a pose's inliers over every candidate pair: with twelve look-alike
+  // candidates per observation it asks for as many samples as if at most one pair in twelve
+  // could be right, even once a pose explains every observation, which no pose can exceed. Such
+  // a pose (of at least four observations, so that its own sample is not all it explains) ends
+  // a sampled search; the enough_* fields are the relocalizer's, set here per frame.
+  budget.enough_inliers = std::numeric_limits<int>::max();
+  budget.enough_score = -std::numeric_limits<double>::infinity();
+  if (sampler != HypothesisSampler::Exhaustive && options.search.stop_when_explained && candidates.num_usable >= 4) {
+    budget.enough_inliers = candidates.num_usable;
+    budget.enough_score = candidates.num_usable * (1.0 - options.search.explained_mean_credit);
+  }
   if (sampler == HypothesisSampler::Exhaustive) {  // try everything: only hypotheses and time bound it
     budget.min_iterations = std::numeric_limits<int>::max() / 2;
     budget.max_iterations = std::numeric_limits<int>::max() / 2;
