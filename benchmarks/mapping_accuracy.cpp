@@ -49,9 +49,14 @@ void printRow(const char* name, const Errors& e) {
 
 int main(int argc, char** argv) {
   int seeds = 5, frames = 60;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--seeds")) seeds = std::atoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--frames")) frames = std::atoi(argv[i + 1]);
+  for (int i = 1; i < argc; i += 2) {
+    const bool known = !std::strcmp(argv[i], "--seeds") || !std::strcmp(argv[i], "--frames");
+    const int value = i + 1 < argc ? std::atoi(argv[i + 1]) : 0;
+    if (!known || value < 1 || value > 100000) {
+      std::fprintf(stderr, "usage: mapping_accuracy [--seeds N] [--frames N]  (N >= 1; defaults 5 and 60)\n");
+      return 2;
+    }
+    (!std::strcmp(argv[i], "--seeds") ? seeds : frames) = value;
   }
   std::printf(
       "Mapping accuracy, %d seeds x %d keyframes per preset; noise: depth 1 cm at 2 m, mask +-2 px, 5%% "

@@ -62,7 +62,11 @@ double medianOrNan(std::vector<double> v) { return ellreloc::median(std::move(v)
 
 }  // namespace
 
-int main() {
+int main(int argc, char**) {
+  if (argc > 1) {
+    std::fprintf(stderr, "usage: observe_accuracy  (no arguments: 2,000 rendered masks, a Markdown table)\n");
+    return 2;
+  }
   std::mt19937 rng(2024);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   // errors[group][method]

@@ -111,12 +111,22 @@ int main(int argc, char** argv) {
   std::string data = ELLRELOC_BENCH_DATA_DIR;
   bool ours_only = false;  // skip the slow exhaustive preset (for timing runs of ours)
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--ours-only")
+    if (std::string(argv[i]) == "--ours-only") {
       ours_only = true;
-    else
+    } else if (argv[i][0] == '-') {
+      std::fprintf(stderr, "usage: reloc_accuracy [--ours-only] [DATA_DIR]  (default %s)\n", ELLRELOC_BENCH_DATA_DIR);
+      return 2;
+    } else {
       data = argv[i];
+    }
   }
-  const auto fr2 = bench::loadFr2Desk(data);
+  bench::RelocalizationDataset fr2;
+  try {
+    fr2 = bench::loadFr2Desk(data);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "reloc_accuracy: %s\n", e.what());
+    return 1;
+  }
   std::printf(
       "| data             | method                 | valid  | median pos | median rot | median time | max time | "
       "hyp/query |\n");
