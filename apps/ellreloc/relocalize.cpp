@@ -259,6 +259,7 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                       {"mean_overlap", r.mean_overlap},
                       {"evidence", r.evidence},
                       {"margin", std::isfinite(r.margin) ? nlohmann::json(r.margin) : nlohmann::json()},
+                      {"samples", r.iterations},
                       {"hypotheses", r.hypotheses},
                       {"budget_exhausted", r.budget_exhausted},
                       {"time_ms", r.time_ms}};
