@@ -165,6 +165,34 @@ std::optional<Eigen::Vector3d> centreAtTypicalSize(const Intrinsics& K, const st
   return centre;
 }
 
+/// The widest angle between two rays through the views' box centres, degrees.
+double baselineDeg(const Intrinsics& K, const std::vector<BoxView>& views) {
+  std::vector<Eigen::Vector3d> rays;
+  for (const BoxView& v : views)
+    rays.push_back(v.pose.rotation().transpose() *
+                   K.bearing(Eigen::Vector2d(0.5 * (v.box.x1 + v.box.x2), 0.5 * (v.box.y1 + v.box.y2))));
+  double min_cos = 1.0;
+  for (size_t i = 0; i < rays.size(); ++i)
+    for (size_t j = i + 1; j < rays.size(); ++j) min_cos = std::min(min_cos, rays[i].dot(rays[j]));
+  return std::acos(std::clamp(min_cos, -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+/// The object's centre from its views: the point nearest to the rays through the box centres
+/// when they span at least `min_baseline_deg`, else (given a prior) on them where the category's
+/// typical size fills the boxes, which `*from_size` then says.
+std::optional<Eigen::Vector3d> centreFromViews(const Intrinsics& K, const std::vector<BoxView>& views,
+                                               double baseline_deg, double min_baseline_deg, const BoxSizePrior* prior,
+                                               bool* from_size) {
+  std::optional<Eigen::Vector3d> centre =
+      baseline_deg < min_baseline_deg ? std::nullopt : triangulateBoxCentres(K, views);
+  *from_size = false;
+  if (!centre && prior) {
+    centre = centreAtTypicalSize(K, views, *prior);
+    *from_size = centre.has_value();
+  }
+  return centre;
+}
+
 }  // namespace
 
 const char* toString(BoxEllipsoidStatus status) {
@@ -229,21 +257,10 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
     out.reason = std::to_string(views.size()) + " valid views";
     return out;
   }
-  // Baseline: the widest angle between two viewing rays through the box centres.
-  std::vector<Eigen::Vector3d> rays;
-  for (const BoxView& v : views)
-    rays.push_back(v.pose.rotation().transpose() *
-                   K.bearing(Eigen::Vector2d(0.5 * (v.box.x1 + v.box.x2), 0.5 * (v.box.y1 + v.box.y2))));
-  double min_cos = 1.0;
-  for (size_t i = 0; i < rays.size(); ++i)
-    for (size_t j = i + 1; j < rays.size(); ++j) min_cos = std::min(min_cos, rays[i].dot(rays[j]));
-  out.baseline_deg = std::acos(std::clamp(min_cos, -1.0, 1.0)) * 180.0 / M_PI;
-  const bool narrow = out.baseline_deg < options.min_baseline_deg;
-  std::optional<Eigen::Vector3d> centre = narrow ? std::nullopt : triangulateBoxCentres(K, views);
-  if (!centre && options.use_size_prior) {
-    centre = centreAtTypicalSize(K, views, prior);
-    out.depth_from_size = centre.has_value();
-  }
+  out.baseline_deg = baselineDeg(K, views);
+  const std::optional<Eigen::Vector3d> centre =
+      centreFromViews(K, views, out.baseline_deg, options.min_baseline_deg, options.use_size_prior ? &prior : nullptr,
+                      &out.depth_from_size);
   if (!centre) {
     out.status = BoxEllipsoidStatus::NoBaseline;
     out.reason = "rays span " + std::to_string(out.baseline_deg) + " deg";
@@ -273,6 +290,39 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
     return out;
   }
   out.status = BoxEllipsoidStatus::Ok;
+  return out;
+}
+
+std::vector<Box> predictedBoxes(const Intrinsics& K, const std::vector<BoxView>& views, const BoxSizePrior& prior,
+                                double min_baseline_deg, const Pose& pose) {
+  std::vector<Box> out;
+  if (!K.isValid() || views.empty() || !pose.isValid()) return out;
+  for (const BoxView& v : views)
+    if (!v.pose.isValid() || !v.box.isValid()) return out;
+  bool from_size = false;
+  const std::optional<Eigen::Vector3d> centre =
+      centreFromViews(K, views, baselineDeg(K, views), min_baseline_deg, &prior, &from_size);
+  if (!centre) return out;
+  const BoxView& last = views.back();
+  // Placed by the typical size, the object may be as much nearer or farther along the last
+  // view's ray as real objects differ from their category's typical size (the prior's range),
+  // in steps of sqrt(2).
+  std::vector<Eigen::Vector3d> centres{*centre};
+  const int steps = from_size ? static_cast<int>(std::floor(2.0 * std::log2(std::max(1.0, prior.range_factor)))) : 0;
+  for (int k = -steps; k <= steps; ++k)
+    if (k != 0) centres.push_back(last.pose.center() + std::pow(2.0, 0.5 * k) * (*centre - last.pose.center()));
+  const Eigen::Vector2d box_centre(0.5 * (last.box.x1 + last.box.x2), 0.5 * (last.box.y1 + last.box.y2));
+  for (const Eigen::Vector3d& x : centres) {
+    const Eigen::Vector3d then = last.pose.transform(x), now = pose.transform(x);
+    if (!(then.z() > 0.0) || !(now.z() > 0.0)) continue;
+    // The last box, moved as the centre's image moves and scaled by the change of depth; the
+    // offset of the box from that image is kept, so an unmoved camera expects the last box.
+    const double scale = then.z() / now.z();
+    const Eigen::Vector2d c = K.project(now) + scale * (box_centre - K.project(then));
+    const Eigen::Vector2d half(0.5 * scale * last.box.width(), 0.5 * scale * last.box.height());
+    const Box box(c.x() - half.x(), c.y() - half.y(), c.x() + half.x(), c.y() + half.y());
+    if (box.isValid()) out.push_back(box);
+  }
   return out;
 }
 

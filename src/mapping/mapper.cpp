@@ -15,6 +15,10 @@
 namespace ellreloc {
 namespace {
 
+/// The views of a young track that place it for the next keyframe's box: its last ones, where
+/// a camera that moved on sees it (and bounding the cost of tracks that never fit).
+constexpr size_t kPredictionViews = 10;
+
 std::string keyframeText(int index) { return "keyframe " + std::to_string(index); }
 
 bool boxFinite(const Box& b) {
@@ -262,12 +266,12 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
 
   // 2D tracking against the objects seen in the last keyframes, by their projected voxels, of
   // each detection with a mask only to objects whose depth range holds the mask's median depth.
-  std::vector<std::pair<size_t, Box>> expected;
+  std::vector<std::pair<size_t, std::vector<Box>>> expected;
   std::vector<std::pair<double, double>> depth_ranges;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (keyframes_ - tracks_[i].last_seen > options_.track_window) continue;
     if (const auto box = tracks_[i].voxels.projectedBox(K_, pose)) {
-      expected.emplace_back(i, *box);
+      expected.emplace_back(i, std::vector<Box>{*box});
       depth_ranges.push_back(depthRange(tracks_[i].voxels, pose));
     }
   }
@@ -370,12 +374,13 @@ void Mapper::mergeDuplicateVoxelTracks() {
   }
 }
 
-std::vector<int> Mapper::associate2D(const std::vector<std::pair<size_t, Box>>& expected,
+std::vector<int> Mapper::associate2D(const std::vector<std::pair<size_t, std::vector<Box>>>& expected,
                                      const std::vector<Detection>& detections, const std::vector<size_t>& used,
                                      const PairGate& gate) const {
   std::vector<LabelledBox> object_boxes, detection_boxes;
-  for (const auto& [track, box] : expected) object_boxes.push_back({box, tracks_[track].label()});
-  for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id});
+  for (const auto& [track, boxes] : expected)
+    object_boxes.push_back({boxes.front(), tracks_[track].label(), {boxes.begin() + 1, boxes.end()}});
+  for (size_t j : used) detection_boxes.push_back({detections[j].bbox, detections[j].category_id, {}});
   std::vector<int> tracked = associateBoxes(object_boxes, detection_boxes, options_.tracking, gate);
   for (int& t : tracked)
     if (t >= 0) t = static_cast<int>(expected[static_cast<size_t>(t)].first);
@@ -393,17 +398,23 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     used.push_back(j);
   }
   // A track's expected box: the projection of its ellipsoid into this keyframe once it has
-  // one (it follows the camera's motion), else its last box when seen in the last keyframes,
-  // else the projection of a sphere at its triangulated centre.
-  std::vector<std::pair<size_t, Box>> expected_boxes;
+  // one, else, when seen in the last keyframes, its last box moved with the camera (keyframes
+  // far apart move a small object further than its size, and a box left where it was would
+  // pair with a neighbour of its label or with nothing), else the projection of a sphere at its
+  // triangulated centre.
+  std::vector<std::pair<size_t, std::vector<Box>>> expected_boxes;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
-    std::optional<Box> expected;
+    std::vector<Box> expected;
     std::optional<Ellipsoid> e;
     if (t.built) {
       e = t.built->object.ellipsoid;
     } else if (keyframes_ - t.last_seen <= options_.track_window) {
-      expected = t.views.back().box;
+      BoxSizePrior prior;
+      prior.typical_semi_axes = typicalSemiAxes(t.label());
+      const size_t recent = std::min(kPredictionViews, t.views.size());
+      expected = predictedBoxes(K_, {t.views.end() - static_cast<long>(recent), t.views.end()}, prior,
+                                options_.boxes.min_baseline_deg, pose);
     } else if (const auto c = triangulateBoxCentres(K_, t.views)) {
       const BoxView& last = t.views.back();
       const double z = last.pose.transform(*c).z();
@@ -412,9 +423,9 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     }
     if (e) {
       const Projection p = project(*e, K_, pose);
-      if (p) expected = p.ellipse.boundingBox();
+      if (p) expected.push_back(p.ellipse.boundingBox());
     }
-    if (expected) expected_boxes.emplace_back(i, *expected);
+    if (!expected.empty()) expected_boxes.emplace_back(i, std::move(expected));
   }
   const std::vector<int> tracked = associate2D(expected_boxes, detections, used);
   for (size_t k = 0; k < used.size(); ++k) {

@@ -185,6 +185,58 @@ TEST(BoxEllipsoidBuilder, ANarrowBaselinePlacesTheObjectByItsTypicalSize) {
   EXPECT_NEAR(depth[1] / depth[0], 2.0, 0.2);
 }
 
+/// The best IoU of `truth` with any of `boxes` (0 for none).
+double bestIoU(const std::vector<Box>& boxes, const Box& truth) {
+  double best = 0.0;
+  for (const Box& b : boxes) best = std::max(best, boxIoU(b, truth));
+  return best;
+}
+
+// Where a young object's next box should be (2D tracking between keyframes far apart): its last
+// box when the camera has not moved; moved with the camera by the nearest point of rays that
+// diverge; and, seen once, at the depth its category's typical size gives or up to four times
+// nearer or farther, so that an object of another size than its category's is still found
+// where the camera's move puts it, which the last box left in place is not.
+TEST(BoxEllipsoidBuilder, PredictedBoxesFollowTheCamera) {
+  // A camera sliding 10 cm at a time past a cup 1.6 m away, looking the same way: the cup's
+  // image moves by more than its width from one keyframe to the next.
+  const Ellipsoid cup(Eigen::Vector3d(0.0, 0.0, 0.4), Eigen::Vector3d(0.04, 0.04, 0.05), Eigen::Matrix3d::Identity());
+  std::vector<BoxView> slide;
+  for (int i = 0; i < 5; ++i) {
+    const Eigen::Vector3d eye(-0.2 + 0.1 * i, -1.5, 0.9);
+    const Pose pose = Pose::lookAt(eye, eye + Eigen::Vector3d(0.0, 1.5, -0.5));
+    const std::optional<Box> box = imageBox(cup, pose);
+    ASSERT_TRUE(box);
+    slide.push_back({pose, *box});
+  }
+  EXPECT_LT(boxIoU(slide[2].box, slide[3].box), 0.1);  // the last box left in place misses it
+  BoxSizePrior typical;
+  typical.typical_semi_axes = cup.axes();
+  const std::vector<BoxView> first(slide.begin(), slide.begin() + 1);
+  const std::vector<Box> unmoved = predictedBoxes(kK, first, typical, 5.0, slide[0].pose);
+  ASSERT_EQ(unmoved.size(), 9u);  // placed by its typical size: nine depths
+  EXPECT_NEAR(boxIoU(unmoved.front(), slide[0].box), 1.0, 1e-9);
+
+  // Seen three times over 7 degrees of rays: triangulated, one box, where the cup's image is next.
+  const std::vector<BoxView> three(slide.begin(), slide.begin() + 3);
+  const std::vector<Box> next = predictedBoxes(kK, three, typical, 5.0, slide[3].pose);
+  ASSERT_EQ(next.size(), 1u);
+  EXPECT_GT(boxIoU(next.front(), slide[3].box), 0.85);
+
+  // Seen once, a cup twice its category's size: the typical depth puts it twice too far, where
+  // the camera's slide moves it half as much; one of the other depths finds it.
+  BoxSizePrior half;
+  half.typical_semi_axes = 0.5 * cup.axes();
+  const std::vector<Box> far = predictedBoxes(kK, first, half, 5.0, slide[2].pose);
+  ASSERT_EQ(far.size(), 9u);
+  EXPECT_LT(boxIoU(far.front(), slide[2].box), 0.3);
+  EXPECT_GT(bestIoU(far, slide[2].box), 0.8);
+
+  EXPECT_TRUE(predictedBoxes(kK, {}, typical, 5.0, slide[0].pose).empty());
+  const Pose away = Pose::lookAt(Eigen::Vector3d(0.0, -1.5, 0.9), Eigen::Vector3d(0.0, -3.0, 0.9));
+  EXPECT_TRUE(predictedBoxes(kK, three, typical, 5.0, away).empty());  // the cup is behind that camera
+}
+
 TEST(BoxEllipsoidBuilder, StatusesInsteadOfGuesses) {
   const Ellipsoid truth(Eigen::Vector3d(0.5, 1.0, 0.4), Eigen::Vector3d(0.3, 0.15, 0.2), Eigen::Matrix3d::Identity());
   EXPECT_EQ(buildEllipsoidFromBoxes(kK, ringViews(truth, 2, 2.0, 60.0)).status, BoxEllipsoidStatus::TooFewViews);

@@ -271,6 +271,41 @@ TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
   EXPECT_LT((twice.map().objects[0].ellipsoid.center() - lower.center()).norm(), 0.05);
 }
 
+// Boxes mode with keyframes far apart, as a SLAM system gives them: a camera sliding 10 cm per
+// keyframe past a row of cups 1.6 m away moves each cup's image by more than its width, so its
+// last box would meet the next cup's box instead of its own. Its box moved with the camera
+// finds it: each cup is mapped once, where it is.
+TEST(Mapper, BoxTracksFollowTheCameraBetweenKeyframesFarApart) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const int kCup = 41;
+  std::vector<Ellipsoid> cups;
+  for (int k = 0; k < 6; ++k)
+    cups.emplace_back(Eigen::Vector3d(-0.3 + 0.12 * k, 0.0, 0.05), Eigen::Vector3d(0.04, 0.04, 0.05),
+                      Eigen::Matrix3d::Identity());
+  MapperOptions options;
+  options.mode = MappingMode::Boxes;
+  Mapper mapper(K, options);
+  for (int i = 0; i < 12; ++i) {
+    const Eigen::Vector3d eye(-0.6 + 0.1 * i, -1.5, 0.6);
+    const Pose pose = Pose::lookAt(eye, eye + Eigen::Vector3d(0.0, 1.5, -0.55));
+    std::vector<Detection> boxes;
+    for (const Ellipsoid& cup : cups) {
+      const Projection p = project(cup, K, pose);
+      const Box b = p ? p.ellipse.boundingBox() : Box();
+      if (p && b.x1 > 0.0 && b.x2 < K.width) boxes.push_back(boxOf(cup, kCup, K, pose));
+    }
+    mapper.addKeyframe(pose, boxes);
+  }
+  mapper.finish();
+  const ObjectMap map = mapper.map();
+  EXPECT_EQ(map.objects.size(), cups.size());
+  for (const Ellipsoid& cup : cups) {
+    int near = 0;
+    for (const MapObject& o : map.objects) near += (o.ellipsoid.center() - cup.center()).norm() < 0.03;
+    EXPECT_EQ(near, 1) << "the cup at x = " << cup.center().x();
+  }
+}
+
 // The objects, their ids included, do not depend on the order a detector lists a keyframe's
 // boxes in, in either mode: the same keyframes with each one's detections shuffled give the
 // same objects to the bit.

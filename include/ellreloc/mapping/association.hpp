@@ -41,6 +41,9 @@ struct TrackingOptions {
 struct LabelledBox {
   Box box;
   int label = 0;
+  /// A map object's other possible boxes (where an object whose depth is not known yet would
+  /// appear at other depths): its overlap with a detection is the best of all its boxes.
+  std::vector<Box> alternatives;
 };
 
 /// Which object-detection pairs 2D association may keep (objects x detections); empty: all.
@@ -57,7 +60,8 @@ inline std::vector<int> associateBoxes(const std::vector<LabelledBox>& objects,
   Eigen::MatrixXd iou(cost.rows(), cost.cols());
   for (size_t i = 0; i < objects.size(); ++i)
     for (size_t j = 0; j < detections.size(); ++j) {
-      const double o = boxIoU(objects[i].box, detections[j].box);
+      double o = boxIoU(objects[i].box, detections[j].box);
+      for (const Box& b : objects[i].alternatives) o = std::max(o, boxIoU(b, detections[j].box));
       const bool other_label = objects[i].label != detections[j].label;
       const bool ruled_out = gate.size() > 0 && !gate(static_cast<long>(i), static_cast<long>(j));
       iou(static_cast<long>(i), static_cast<long>(j)) = ruled_out ? 0.0 : o;

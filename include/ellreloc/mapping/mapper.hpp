@@ -141,9 +141,9 @@ class Mapper {
   void addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage& depth,
                         KeyframeReport* report);
   /// 2D association (association.hpp) of the used detections with tracks' expected boxes
-  /// (track index, box): each used detection's track index, or -1. `gate` (expected x used)
-  /// rules pairs out; empty: none.
-  std::vector<int> associate2D(const std::vector<std::pair<size_t, Box>>& expected,
+  /// (track index, its possible boxes, at least one): each used detection's track index, or -1.
+  /// `gate` (expected x used) rules pairs out; empty: none.
+  std::vector<int> associate2D(const std::vector<std::pair<size_t, std::vector<Box>>>& expected,
                                const std::vector<Detection>& detections, const std::vector<size_t>& used,
                                const PairGate& gate = {}) const;
   void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report);
