@@ -4,7 +4,8 @@ one scripts/benchmarks.sh run.
 A region is the text between `<!-- bench:NAME -->` and `<!-- /bench:NAME -->`; NAME is a result
 in the results folder: NAME.json (Google Benchmark, medians shown) or NAME.txt (an accuracy
 binary's output, whose Markdown table lines are kept). Each region gets a stamp line with the
-date, the core count and the command. Regions without a result are left as they are.
+date the result was written, the core count and the command. Regions without a result are left
+as they are.
 """
 import datetime
 import json
@@ -45,7 +46,6 @@ def main(results, doc, cores):
     results = pathlib.Path(results)
     doc = pathlib.Path(doc)
     text = doc.read_text()
-    today = datetime.date.today().isoformat()
 
     def replace(m):
         name = m.group(1)
@@ -54,7 +54,8 @@ def main(results, doc, cores):
             if result.exists():
                 command = (results / (name + ".command")).read_text().strip()
                 body = make(result)
-                stamp = f"Measured {today} on {cores} cores: `{command}`"
+                measured = datetime.date.fromtimestamp(result.stat().st_mtime).isoformat()
+                stamp = f"Measured {measured} on {cores} cores: `{command}`"
                 return f"<!-- bench:{name} -->\n{stamp}\n\n{body}\n<!-- /bench:{name} -->"
         return m.group(0)
 

@@ -48,6 +48,7 @@ else
 fi
 table real_data python3 scripts/real_data.py "$build"
 table fr3_splits python3 scripts/fr3_splits.py "$build"
+table keyframe_maps python3 scripts/keyframe_maps.py "$build"
 table detection_orders python3 scripts/detection_orders.py "$build"
 table null_frames python3 scripts/null_frames.py "$build"
 table acceptance_margin python3 scripts/acceptance_margin.py "$build"
