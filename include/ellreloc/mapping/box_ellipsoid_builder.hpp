@@ -102,9 +102,9 @@ std::optional<Eigen::Vector3d> triangulateBoxCentres(const Intrinsics& K, const 
 /// the rays through its boxes' centres when they span at least `min_baseline_deg` (one box);
 /// else on them where its category's typical size fills the boxes, and also up to the prior's
 /// `range_factor` times nearer or farther along the last ray, in steps of sqrt(2) (nine boxes
-/// for the default 4: a real object is not its category's typical size). Empty when the object would be behind a camera
-/// or the input is invalid. For 2D tracking between keyframes far apart (a SLAM system's), where a small object moves
-/// further than its size in the image.
+/// for the default 4: a real object is not its category's typical size). Empty when the object
+/// would be behind a camera or the input is invalid. For 2D tracking between keyframes far
+/// apart (a SLAM system's), where a small object moves further than its size in the image.
 std::vector<Box> predictedBoxes(const Intrinsics& K, const std::vector<BoxView>& views, const BoxSizePrior& prior,
                                 double min_baseline_deg, const Pose& pose);
 
