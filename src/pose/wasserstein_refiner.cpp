@@ -178,8 +178,9 @@ struct CeresObjectCost {
         c(e.center()),
         K(K.K()),
         inv_scale(1.0 / scale) {}
+  /// Flattened, as normalEquations: GCC calls Eigen's kernels for the Jets out of line.
   template <typename T>
-  bool operator()(const T* q, const T* t, T* r) const {
+  [[gnu::flatten]] bool operator()(const T* q, const T* t, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> quat(q);
     const Mat3<T> R = quat.normalized().toRotationMatrix();
     const Eigen::Matrix<T, 3, 1> tt(t[0], t[1], t[2]);
