@@ -191,8 +191,11 @@ void map(const MapArgs& a, const Console& console) {
                        result.objects.end());
   io::writeMap(a.out, result);
   if (!console.quiet) {
-    std::printf("wrote %s: %zu objects from %d keyframes (%s mode; %d frames without pose, %d without depth)\n",
-                a.out.c_str(), result.objects.size(), used, a.mode.c_str(), no_pose, no_depth);
+    // Boxes mode reads no depth: only voxel mode can miss one.
+    const std::string no_depth_text =
+        options.mode == MappingMode::Voxel ? ", " + std::to_string(no_depth) + " without depth" : "";
+    std::printf("wrote %s: %zu objects from %d keyframes (%s mode; %d frames without pose%s)\n", a.out.c_str(),
+                result.objects.size(), used, a.mode.c_str(), no_pose, no_depth_text.c_str());
     printSummary(result, dropped, mapper.stats(), options.min_observations);
   }
   if (!a.holdout.empty() || a.holdout_every > 0) printQuality(measureMapQuality(result, K, held_out));

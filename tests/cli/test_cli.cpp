@@ -254,6 +254,7 @@ TEST(Cli, Fr3BoxesMapAndRelocalizationStayAboveTheMeasuredFloors) {
                      " --mode boxes --holdout " + dir.path("query.json") + " --out " + dir.path("map.json"),
                  dir);
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("without depth"), std::string::npos) << r.out;  // boxes mode reads no depth
   double quality = 0.0;
   ASSERT_EQ(std::sscanf(r.out.substr(r.out.find("IoU ")).c_str(), "IoU %lf", &quality), 1) << r.out;
   EXPECT_GE(quality, 0.73) << r.out;  // measured 0.775
