@@ -631,6 +631,7 @@ class SearchOptions:
     check_sample_overlap: bool
     stop_when_explained: bool
     explained_mean_credit: float
+    refine_explained: bool
     budget: SearchBudget
     max_overlap_evaluations: int
     max_candidate_pairs: int

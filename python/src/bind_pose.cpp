@@ -181,6 +181,8 @@ void bindOptionGroups(py::module_& m) {
                      "end a sampled search once a pose explains every usable observation (at least four) well")
       .def_readwrite("explained_mean_credit", &SearchOptions::explained_mean_credit,
                      "the mean credit (overlap) such a pose needs")
+      .def_readwrite("refine_explained", &SearchOptions::refine_explained,
+                     "refine a hypothesis that explains every usable observation (at least four) loosely, when scored")
       .def_readwrite("budget", &SearchOptions::budget)
       .def_readwrite("max_overlap_evaluations", &SearchOptions::max_overlap_evaluations)
       .def_readwrite("max_candidate_pairs", &SearchOptions::max_candidate_pairs)

@@ -10,8 +10,7 @@
 #include <random>
 
 #include "ellreloc/core/distances.hpp"
-#include "ellreloc/sim/map_observations.hpp"
-#include "fixtures/random_geometry.hpp"
+#include "fixtures/observed_scene.hpp"
 #include "pose/pipeline/candidates.hpp"
 #include "pose/pipeline/pose_scorer.hpp"
 
@@ -19,27 +18,10 @@ using namespace ellreloc;
 
 namespace {
 
-/// 25 objects of four categories (look-alikes) within +-spread m of the origin in x and y and
-/// +-0.3 m in z, observed from a random pose looking at them, with 3 px of centre noise.
-struct ScorerScene {
-  ObjectMap map;
-  Pose truth;
-  std::vector<Observation> observations;
-};
-
-ScorerScene randomScorerScene(double spread, const Intrinsics& K, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  ScorerScene s;
-  for (int i = 0; i < 25; ++i)
-    s.map.objects.push_back(
-        {i, i % 4, "",
-         Ellipsoid({spread * u(rng), spread * u(rng), 0.3 * u(rng)},
-                   {0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng)}, Eigen::Matrix3d::Identity())});
-  s.truth = test::randomLookAtPose(rng);
-  sim::MapObservationOptions noise;
-  noise.centre_sigma_px = 3.0;
-  s.observations = sim::observeMap(s.map, K, s.truth, noise, &rng);
-  return s;
+/// 25 objects of four categories (look-alikes) within +-spread m of the origin, with 3 px of
+/// centre noise.
+test::ObservedScene randomScorerScene(double spread, const Intrinsics& K, std::mt19937& rng) {
+  return test::randomObservedScene(25, 4, spread, 3.0, K, rng);
 }
 
 /// The truth turned by up to `step` radians and moved by up to `step` m along each axis.

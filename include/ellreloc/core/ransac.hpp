@@ -12,7 +12,8 @@
 ///   static constexpr int kMaxModels;         // models one minimal sample can produce
 ///   size_t numData() const;
 ///   int generate(const int* sample, Model* models) const;      // fills up to kMaxModels
-///   double score(const Model& m, int* num_inliers) const;       // MSAC cost: lower is better
+///   double score(Model& m, int* num_inliers) const;       // MSAC cost: lower is better; may
+///                                                          // improve m in place (local optimisation)
 /// A sample the estimator cannot use (e.g. repeated observations) simply generates 0 models.
 
 #include <algorithm>

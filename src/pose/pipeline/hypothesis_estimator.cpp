@@ -20,6 +20,11 @@ EllipseMatch ellipseMatchOf(const CandidatePair& pair, const std::vector<Observa
 
 }  // namespace
 
+EllipseMatch refinerMatch(const Observation& o, const Ellipsoid& e, const RefinementStageOptions& options) {
+  const bool regular_fit = o.source == EllipseSource::Mask && o.regular.value_or(false);
+  return {o.ellipse, e, regular_fit ? options.regular_mask_sigma : 1.0};
+}
+
 bool HypothesisEstimator::accept(const Pose& pose, const int* pair_indices, int count, bool check_overlap,
                                  KnownProjections* own) const {
   if (!gate_.admits(pose)) return false;
@@ -113,12 +118,37 @@ bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
   return n > 0;
 }
 
-double HypothesisEstimator::score(const Model& model, int* num_inliers) const {
+double HypothesisEstimator::score(Model& model, int* num_inliers) const {
   thread_local std::vector<ObjectCorrespondence> matches;
   const double give_up_at = pool_ ? pool_->admissionCost() : std::numeric_limits<double>::infinity();
   const double cost = scorer_.cost(model.pose, kRankingIoUVertices, &matches, &model.own, give_up_at);
   *num_inliers = static_cast<int>(matches.size());
+  // Few hypotheses explain every observation (tens in a frame of thousands), so refining them
+  // costs little; one that is loose is most often a right triplet's pose centimetres off.
+  const SearchOptions& search = options_.search;
+  const double explained_cost = num_usable_ * (1.0 - search.explained_mean_credit);
+  if (search.refine_explained && num_usable_ >= 4 && *num_inliers >= num_usable_ && cost > explained_cost &&
+      std::isfinite(cost))
+    return refineExplained(&model, matches, cost, give_up_at, num_inliers);
   return cost;
+}
+
+double HypothesisEstimator::refineExplained(Model* model, const std::vector<ObjectCorrespondence>& matches, double cost,
+                                            double give_up_at, int* num_inliers) const {
+  std::vector<EllipseMatch> pairs;
+  pairs.reserve(matches.size());
+  for (const ObjectCorrespondence& m : matches)
+    pairs.push_back(refinerMatch(observations_[static_cast<size_t>(m.observation)],
+                                 map_.objects[static_cast<size_t>(m.object)].ellipsoid, options_.refinement));
+  const RefinementResult r = refinePose(K_, model->pose, pairs, {}, options_.refinement.refiner);
+  if (r.fell_back || !gate_.admits(r.pose)) return cost;
+  thread_local std::vector<ObjectCorrespondence> rematched;
+  const double refined_cost = scorer_.cost(r.pose, kRankingIoUVertices, &rematched, nullptr, give_up_at);
+  if (!(refined_cost < cost)) return cost;
+  model->pose = r.pose;
+  model->own.count = 0;  // its projections were the unrefined pose's
+  *num_inliers = static_cast<int>(rematched.size());
+  return refined_cost;
 }
 
 void HypothesisEstimator::fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,

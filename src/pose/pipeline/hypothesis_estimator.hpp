@@ -26,6 +26,10 @@ struct PoseGate {
   }
 };
 
+/// The pair the refiner reads for a match: an ellipse fitted to a regular mask weighs by
+/// `regular_mask_sigma` (RefinementStageOptions), any other ellipse by 1.
+EllipseMatch refinerMatch(const Observation& o, const Ellipsoid& e, const RefinementStageOptions& options);
+
 /// A hypothesis: a pose and its own objects' projections at it.
 struct PoseHypothesis {
   Pose pose;
@@ -50,14 +54,16 @@ class HypothesisEstimator {
         options_(options),
         gate_(gate),
         scorer_(scorer),
-        pool_(pool) {}
+        pool_(pool),
+        num_usable_(candidates.num_usable) {}
 
   // The RANSAC estimator concept (core/ransac.hpp) over candidate pairs.
   size_t numData() const { return pairs_.size(); }
   /// P3P on the observed centres of three pairs, with the projected-centre correction.
   int generate(const int* sample, Model* models) const;
-  /// The ranking cost (PoseScorer::cost at kRankingIoUVertices).
-  double score(const Model& model, int* num_inliers) const;
+  /// The ranking cost (PoseScorer::cost at kRankingIoUVertices). A model that explains every
+  /// usable observation loosely is refined first when the options ask (refine_explained).
+  double score(Model& model, int* num_inliers) const;
 
   /// Poses from two candidate pairs (two-object solver), checked like P3P's; appended to `out`.
   void fromTwoPairs(int a, int b, const std::optional<GravityPrior>& gravity, std::vector<Model>* out) const;
@@ -72,6 +78,10 @@ class HypothesisEstimator {
   /// observation by scoring.min_overlap (PoseScorer::sizeMayReach).
   bool ownSizesMayFit(const Pose& pose, const int* sample) const;
   bool correctCentres(const int* pair_indices, Pose* pose) const;
+  /// score()'s local optimisation: `model` refined on its `matches` replaces it when that scores
+  /// lower; returns the model's cost, `cost` when unchanged.
+  double refineExplained(Model* model, const std::vector<ObjectCorrespondence>& matches, double cost, double give_up_at,
+                         int* num_inliers) const;
   void fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,
                   std::vector<Model>* out) const;
 
@@ -83,6 +93,7 @@ class HypothesisEstimator {
   PoseGate gate_;
   PoseScorer& scorer_;
   const HypothesisPool* pool_;
+  int num_usable_;
 };
 
 }  // namespace ellreloc::pipeline

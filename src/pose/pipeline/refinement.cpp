@@ -44,12 +44,10 @@ std::vector<EllipseMatch> ellipseMatches(const std::vector<ObjectCorrespondence>
                                          const RefinementContext& context) {
   std::vector<EllipseMatch> out;
   out.reserve(matches.size());
-  for (const ObjectCorrespondence& m : matches) {
-    const Observation& o = context.observations[static_cast<size_t>(m.observation)];
-    const bool regular_fit = o.source == EllipseSource::Mask && o.regular.value_or(false);
-    out.push_back({o.ellipse, context.map.objects[static_cast<size_t>(m.object)].ellipsoid,
-                   regular_fit ? context.options.refinement.regular_mask_sigma : 1.0});
-  }
+  for (const ObjectCorrespondence& m : matches)
+    out.push_back(refinerMatch(context.observations[static_cast<size_t>(m.observation)],
+                               context.map.objects[static_cast<size_t>(m.object)].ellipsoid,
+                               context.options.refinement));
   return out;
 }
 

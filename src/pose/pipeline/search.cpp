@@ -113,9 +113,10 @@ void searchFewObjects(const HypothesisEstimator& estimator, const Candidates& ca
     outcome->budget_exhausted = true;
   }
   // They compete with the triplets' poses in the same score.
-  for (const PoseHypothesis& h : poses) {
+  for (PoseHypothesis& h : poses) {
     int inliers = 0;
-    pool->offer(h.pose, estimator.score(h, &inliers));
+    const double cost = estimator.score(h, &inliers);  // may refine h
+    pool->offer(h.pose, cost);
   }
   outcome->few_object_hypotheses = static_cast<long>(poses.size());
   outcome->hypotheses += outcome->few_object_hypotheses;
