@@ -1,9 +1,10 @@
 // The hypothesis estimator's local optimisation: a hypothesis that explains every usable
-// observation, but loosely, is refined when scored, and the refined pose replaces it when it
-// scores lower; any other hypothesis is scored as it is.
+// observation, but loosely, is refined (refineIfLoose), and the refined pose replaces it when it
+// scores lower; any other hypothesis, or one that could not enter the pool, is kept as it is.
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "fixtures/observed_scene.hpp"
@@ -33,9 +34,10 @@ Pose offTheTruth(const Pose& truth, double angle, double shift, std::mt19937& rn
 
 }  // namespace
 
-TEST(HypothesisEstimator, ALooseHypothesisExplainingEveryObservationIsRefinedWhenScored) {
+TEST(HypothesisEstimator, ALooseHypothesisExplainingEveryObservationIsRefined) {
   std::mt19937 rng(95);
   const Intrinsics K = test::testIntrinsics();
+  const double anything = std::numeric_limits<double>::infinity();  // an admission any cost passes
   int refined = 0, loose = 0;
   for (int scene = 0; scene < 10; ++scene) {
     auto [map, truth, observations] = randomEstimatorScene(K, rng);
@@ -61,11 +63,20 @@ TEST(HypothesisEstimator, ALooseHypothesisExplainingEveryObservationIsRefinedWhe
       const Pose start = offTheTruth(truth, 0.035, 0.06, rng);
       std::vector<ObjectCorrespondence> matches;
       const double start_cost = scorer.cost(start, pipeline::kRankingIoUVertices, &matches);
-      pipeline::PoseHypothesis kept{start, {}}, h{start, {}};
-      int kept_inliers = 0, inliers = 0;
-      EXPECT_EQ(raw.score(kept, &kept_inliers), start_cost);
-      EXPECT_TRUE(kept.pose.translation() == start.translation() && kept.pose.rotation() == start.rotation());
-      const double cost = refining.score(h, &inliers);
+      pipeline::PoseHypothesis h{start, {}};
+      int inliers = 0;
+      const double scored = refining.score(h, &inliers);
+      EXPECT_EQ(scored, start_cost);
+      // Kept as it is with the option off, or when it could not enter the pool.
+      for (const double admission : {anything, scored}) {
+        pipeline::PoseHypothesis kept = h;
+        int kept_inliers = inliers;
+        const pipeline::HypothesisEstimator& estimator = admission == anything ? raw : refining;
+        EXPECT_EQ(estimator.refineIfLoose(&kept, scored, &kept_inliers, admission), scored);
+        EXPECT_TRUE(kept.pose.translation() == start.translation() && kept.pose.rotation() == start.rotation());
+        EXPECT_EQ(kept_inliers, inliers);
+      }
+      const double cost = refining.refineIfLoose(&h, scored, &inliers, anything);
       const bool is_loose = static_cast<int>(matches.size()) == candidates.num_usable && start_cost > explained_cost;
       loose += is_loose;
       if (decoy) EXPECT_FALSE(is_loose);

@@ -3,8 +3,9 @@
 /// A generic RANSAC engine (header-only) over a duck-typed estimator, with pluggable samplers
 /// (exhaustive enumeration, uniform random, PROSAC), MSAC-style scoring, an adaptive iteration
 /// count with clamps, an explicit seed, hypothesis and time budgets, and statistics. An
-/// optional observer sees every scored model (the relocalizer keeps its best few that way and
-/// refines them after the loop).
+/// optional observer sees every scored model, in sample order on the calling thread, and may
+/// improve it in place before the stopping rules read it (local optimisation); the relocalizer
+/// keeps its best few that way and refines them after the loop.
 ///
 /// An Estimator provides:
 ///   using Model = ...;                       // a hypothesis
@@ -12,8 +13,7 @@
 ///   static constexpr int kMaxModels;         // models one minimal sample can produce
 ///   size_t numData() const;
 ///   int generate(const int* sample, Model* models) const;      // fills up to kMaxModels
-///   double score(Model& m, int* num_inliers) const;       // MSAC cost: lower is better; may
-///                                                          // improve m in place (local optimisation)
+///   double score(const Model& m, int* num_inliers) const;       // MSAC cost: lower is better
 /// A sample the estimator cannot use (e.g. repeated observations) simply generates 0 models.
 
 #include <algorithm>
@@ -311,11 +311,11 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
       else
         work(0);
     }
-    const Slot& s = batch[static_cast<size_t>(cursor++)];
+    Slot& s = batch[static_cast<size_t>(cursor++)];
     ++st.iterations;
     for (int i = 0; i < s.count; ++i) {
       ++st.hypotheses;
-      observer(s.models[i], s.scores[i], s.inliers[i]);
+      observer(s.models[i], s.scores[i], s.inliers[i]);  // may improve them (on this thread, in order)
       if (s.scores[i] < st.score) {
         st.score = s.scores[i];
         st.num_inliers = s.inliers[i];
@@ -337,7 +337,8 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
 }
 
 /// Runs RANSAC on one thread. `best` receives the best model; returns false when no model was
-/// generated. `observer(model, score, num_inliers)` is called for every scored model, in order.
+/// generated. `observer(model, score, num_inliers)` is called for every scored model, in order,
+/// with lvalues it may change (a better model and its score and inliers: local optimisation).
 template <typename Estimator, typename Sampler, typename Observer = IgnoreScoredModels>
 bool ransac(const Estimator& estimator, Sampler& sampler, const RansacOptions& options, typename Estimator::Model* best,
             RansacStats* stats, Observer&& observer = Observer{}) {

@@ -118,23 +118,24 @@ bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
   return n > 0;
 }
 
-double HypothesisEstimator::score(Model& model, int* num_inliers) const {
+double HypothesisEstimator::score(const Model& model, int* num_inliers) const {
   thread_local std::vector<ObjectCorrespondence> matches;
   const double give_up_at = pool_ ? pool_->admissionCost() : std::numeric_limits<double>::infinity();
   const double cost = scorer_.cost(model.pose, kRankingIoUVertices, &matches, &model.own, give_up_at);
   *num_inliers = static_cast<int>(matches.size());
+  return cost;
+}
+
+double HypothesisEstimator::refineIfLoose(Model* model, double cost, int* num_inliers, double admission) const {
   // Few hypotheses explain every observation (tens in a frame of thousands), so refining them
   // costs little; one that is loose is most often a right triplet's pose centimetres off.
   const SearchOptions& search = options_.search;
   const double explained_cost = num_usable_ * (1.0 - search.explained_mean_credit);
-  if (search.refine_explained && num_usable_ >= 4 && *num_inliers >= num_usable_ && cost > explained_cost &&
-      std::isfinite(cost))
-    return refineExplained(&model, matches, cost, give_up_at, num_inliers);
-  return cost;
-}
-
-double HypothesisEstimator::refineExplained(Model* model, const std::vector<ObjectCorrespondence>& matches, double cost,
-                                            double give_up_at, int* num_inliers) const {
+  if (!search.refine_explained || num_usable_ < 4 || *num_inliers < num_usable_ || !(cost > explained_cost) ||
+      !(cost < admission))
+    return cost;
+  thread_local std::vector<ObjectCorrespondence> matches;
+  scorer_.cost(model->pose, kRankingIoUVertices, &matches, &model->own);  // its matches, as scored
   std::vector<EllipseMatch> pairs;
   pairs.reserve(matches.size());
   for (const ObjectCorrespondence& m : matches)
@@ -143,7 +144,7 @@ double HypothesisEstimator::refineExplained(Model* model, const std::vector<Obje
   const RefinementResult r = refinePose(K_, model->pose, pairs, {}, options_.refinement.refiner);
   if (r.fell_back || !gate_.admits(r.pose)) return cost;
   thread_local std::vector<ObjectCorrespondence> rematched;
-  const double refined_cost = scorer_.cost(r.pose, kRankingIoUVertices, &rematched, nullptr, give_up_at);
+  const double refined_cost = scorer_.cost(r.pose, kRankingIoUVertices, &rematched, nullptr, admission);
   if (!(refined_cost < cost)) return cost;
   model->pose = r.pose;
   model->own.count = 0;  // its projections were the unrefined pose's

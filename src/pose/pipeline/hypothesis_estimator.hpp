@@ -61,9 +61,15 @@ class HypothesisEstimator {
   size_t numData() const { return pairs_.size(); }
   /// P3P on the observed centres of three pairs, with the projected-centre correction.
   int generate(const int* sample, Model* models) const;
-  /// The ranking cost (PoseScorer::cost at kRankingIoUVertices). A model that explains every
-  /// usable observation loosely is refined first when the options ask (refine_explained).
-  double score(Model& model, int* num_inliers) const;
+  /// The ranking cost (PoseScorer::cost at kRankingIoUVertices).
+  double score(const Model& model, int* num_inliers) const;
+  /// Local optimisation (search.refine_explained): a model of `cost` below `admission` (the
+  /// pool's) whose `num_inliers` matches explain every usable observation, at least four, with a
+  /// mean credit below search.explained_mean_credit is refined on its matches, and replaced by
+  /// the refined pose when that scores lower; returns the model's cost, `num_inliers` updated.
+  /// Called where the pool is current (in sample order), so that the search's result does not
+  /// depend on its thread count: a scorer on another thread may have read an older admission.
+  double refineIfLoose(Model* model, double cost, int* num_inliers, double admission) const;
 
   /// Poses from two candidate pairs (two-object solver), checked like P3P's; appended to `out`.
   void fromTwoPairs(int a, int b, const std::optional<GravityPrior>& gravity, std::vector<Model>* out) const;
@@ -78,10 +84,6 @@ class HypothesisEstimator {
   /// observation by scoring.min_overlap (PoseScorer::sizeMayReach).
   bool ownSizesMayFit(const Pose& pose, const int* sample) const;
   bool correctCentres(const int* pair_indices, Pose* pose) const;
-  /// score()'s local optimisation: `model` refined on its `matches` replaces it when that scores
-  /// lower; returns the model's cost, `cost` when unchanged.
-  double refineExplained(Model* model, const std::vector<ObjectCorrespondence>& matches, double cost, double give_up_at,
-                         int* num_inliers) const;
   void fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,
                   std::vector<Model>* out) const;
 

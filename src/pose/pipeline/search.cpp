@@ -52,7 +52,13 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
     budget.min_iterations = std::numeric_limits<int>::max() / 2;
     budget.max_iterations = std::numeric_limits<int>::max() / 2;
   }
-  const auto remember = [pool](const PoseHypothesis& h, double cost, int) { pool->offer(h.pose, cost); };
+  // In sample order on this thread, where the pool is current: a loose hypothesis that explains
+  // every observation is refined first (estimators.front()'s scorer is idle meanwhile).
+  const HypothesisEstimator& local = *estimators.front();
+  const auto remember = [pool, &local](PoseHypothesis& h, double& cost, int& inliers) {
+    cost = local.refineIfLoose(&h, cost, &inliers, pool->admissionCost());
+    pool->offer(h.pose, cost);
+  };
   PoseHypothesis best;
   RansacStats stats;
   bool found = false;
@@ -115,7 +121,8 @@ void searchFewObjects(const HypothesisEstimator& estimator, const Candidates& ca
   // They compete with the triplets' poses in the same score.
   for (PoseHypothesis& h : poses) {
     int inliers = 0;
-    const double cost = estimator.score(h, &inliers);  // may refine h
+    double cost = estimator.score(h, &inliers);
+    cost = estimator.refineIfLoose(&h, cost, &inliers, pool->admissionCost());
     pool->offer(h.pose, cost);
   }
   outcome->few_object_hypotheses = static_cast<long>(poses.size());
