@@ -130,9 +130,8 @@ double HypothesisEstimator::refineIfLoose(Model* model, double cost, int* num_in
   // Few hypotheses explain every observation (tens in a frame of thousands), so refining them
   // costs little; one that is loose is most often a right triplet's pose centimetres off.
   const SearchOptions& search = options_.search;
-  const double explained_cost = num_usable_ * (1.0 - search.explained_mean_credit);
-  if (!search.refine_explained || num_usable_ < 4 || *num_inliers < num_usable_ || !(cost > explained_cost) ||
-      !(cost < admission))
+  if (!search.refine_explained || num_usable_ < kMinExplainedObservations || *num_inliers < num_usable_ ||
+      !(cost > explainedCost(search, num_usable_)) || !(cost < admission))
     return cost;
   thread_local std::vector<ObjectCorrespondence> matches;
   scorer_.cost(model->pose, kRankingIoUVertices, &matches, &model->own);  // its matches, as scored

@@ -26,6 +26,15 @@ struct PoseGate {
   }
 };
 
+/// A pose that explains all of a frame's usable observations explains them well at this cost or
+/// below (a mean credit of search.explained_mean_credit): it ends a sampled search
+/// (stop_when_explained), and one above it is refined (refine_explained). Neither applies below
+/// kMinExplainedObservations, where a pose's own sample is most of what it explains.
+constexpr int kMinExplainedObservations = 4;
+inline double explainedCost(const SearchOptions& search, int num_usable) {
+  return num_usable * (1.0 - search.explained_mean_credit);
+}
+
 /// The pair the refiner reads for a match: an ellipse fitted to a regular mask weighs by
 /// `regular_mask_sigma` (RefinementStageOptions), any other ellipse by 1.
 EllipseMatch refinerMatch(const Observation& o, const Ellipsoid& e, const RefinementStageOptions& options);

@@ -40,13 +40,14 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
   // The adaptive count reads a pose's inliers over every candidate pair: with twelve look-alike
   // candidates per observation it asks for as many samples as if at most one pair in twelve
   // could be right, even once a pose explains every observation, which no pose can exceed. Such
-  // a pose (of at least four observations, so that its own sample is not all it explains) ends
-  // a sampled search; the enough_* fields are the relocalizer's, set here per frame.
+  // a pose (explainedCost) ends a sampled search; the enough_* fields are the relocalizer's, set
+  // here per frame.
   budget.enough_inliers = std::numeric_limits<int>::max();
   budget.enough_score = -std::numeric_limits<double>::infinity();
-  if (sampler != HypothesisSampler::Exhaustive && options.search.stop_when_explained && candidates.num_usable >= 4) {
+  if (sampler != HypothesisSampler::Exhaustive && options.search.stop_when_explained &&
+      candidates.num_usable >= kMinExplainedObservations) {
     budget.enough_inliers = candidates.num_usable;
-    budget.enough_score = candidates.num_usable * (1.0 - options.search.explained_mean_credit);
+    budget.enough_score = explainedCost(options.search, candidates.num_usable);
   }
   if (sampler == HypothesisSampler::Exhaustive) {  // try everything: only hypotheses and time bound it
     budget.min_iterations = std::numeric_limits<int>::max() / 2;
