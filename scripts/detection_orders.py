@@ -23,7 +23,7 @@ import sys
 import tempfile
 
 from fr3_splits import splits  # noqa: E402
-from real_data import box_map, data, relocalize  # noqa: E402  (same arguments as real_data.py)
+from real_data import box_map, data, fr3, relocalize  # noqa: E402  (same arguments as real_data.py)
 
 orders = int(sys.argv[3]) if len(sys.argv) > 3 else 8
 if orders < 1:
@@ -45,7 +45,6 @@ def shuffled(path, seed, work):
 
 def main():
     fr2 = os.path.join(data, "tum_fr2_desk")
-    fr3 = os.path.join(data, "tum_fr3_office_first_half")
     s11 = os.path.join(data, "independent_synth", "office_s11")
     methods = (("ours", "ours", ()), ("ours, every pose", "ours", ("--accept-all",)), ("oa-slam preset", "oa-slam", ()))
     print("| data | method | valid, given order | mean over %d orders | lowest - highest |" % orders)

@@ -17,6 +17,7 @@ noise (their own mean): the first 40, 55, 65 and 80% (every 5th frame of the res
 frames in three offset by one ("thirds+1": every 5th of the others).
 
 Usage: scripts/fr3_splits.py [BUILD_DIR] [DATA_DIR]   (prints a Markdown table)
+ELLRELOC_FR3=FOLDER splits another part of the sequence in the same layout (real_data.py).
 """
 import json
 import os
@@ -24,7 +25,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from real_data import box_map, data, relocalize  # noqa: E402  (same arguments as real_data.py)
+from real_data import box_map, data, fr3, relocalize  # noqa: E402  (same arguments as real_data.py)
 
 
 def splits(frames):
@@ -63,7 +64,6 @@ def table(name_of_mean, chosen, camera, groundtruth, work, first_key):
 
 
 def main():
-    fr3 = os.path.join(data, "tum_fr3_office_first_half")
     camera, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
     frames = json.load(open(os.path.join(fr3, "detections.json")))
     print("| split | map frames | query frames | map | ours | ours, every pose | oa-slam preset |")

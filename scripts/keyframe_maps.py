@@ -21,13 +21,12 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from real_data import box_map, data, relocalize  # noqa: E402  (same arguments as real_data.py)
+from real_data import box_map, data, fr3, relocalize  # noqa: E402  (same arguments as real_data.py)
 
 
 def keyframe_splits():
     """(name, camera, ground truth, mapping frames, query frames) of each row."""
     fr2 = os.path.join(data, "tum_fr2_desk")
-    fr3 = os.path.join(data, "tum_fr3_office_first_half")
     keyframes = json.load(open(os.path.join(fr2, "keyframes.detections.json")))
     frames = json.load(open(os.path.join(fr3, "detections.json")))
     cut = int(0.6 * len(frames))

@@ -23,7 +23,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from real_data import box_map, data, run, table_splits  # noqa: E402  (same arguments as real_data.py)
+from real_data import box_map, data, fr3, run, table_splits  # noqa: E402  (same arguments as real_data.py)
 
 
 def moved_boxes(frames, width, height, seed):
@@ -66,7 +66,7 @@ def image_size(camera):
 def null_sets(work):
     """The null sets as (label, camera, map path, frames), and the real query sets of the same maps
     as (label, camera, map path, frames, ground truth); the fr3 maps are built in `work`."""
-    fr2, fr3 = os.path.join(data, "tum_fr2_desk"), os.path.join(data, "tum_fr3_office_first_half")
+    fr2 = os.path.join(data, "tum_fr2_desk")
     s11 = os.path.join(data, "independent_synth", "office_s11")
     fr2_cam, fr3_cam, s11_cam = (os.path.join(d, "camera.yaml") for d in (fr2, fr3, s11))
     fr2_frames = json.load(open(os.path.join(fr2, "keyframes.detections.json")))

@@ -23,6 +23,9 @@ frame is its first keyframe's camera, so about -y; office_s11's world is z-up) w
 `--max-tilt 90`.
 
 Usage: scripts/real_data.py [BUILD_DIR] [DATA_DIR]   (prints a Markdown table)
+The fr3 rows split ELLRELOC_FR3 when it names a folder of the first half's layout (e.g. the
+second half of the sequence), else DATA_DIR/tum_fr3_office_first_half; the scripts that import
+this one do the same.
 """
 import json
 import os
@@ -38,6 +41,14 @@ if not os.access(cli, os.X_OK):
     sys.exit("%s: no ellreloc command at %s (build first: scripts/build.sh)" % (sys.argv[0], cli))
 if not os.path.isdir(os.path.join(data, "tum_fr2_desk")):
     sys.exit("%s: %s is not the shared data folder (no tum_fr2_desk in it)" % (sys.argv[0], data))
+# The fr3/long_office sequence the fr3 rows split: the shipped first half, or another part of
+# the sequence in the same layout (camera.yaml, groundtruth.txt, detections.json), e.g. its
+# second half, given by ELLRELOC_FR3.
+fr3 = os.environ.get("ELLRELOC_FR3") or os.path.join(data, "tum_fr3_office_first_half")
+for name in ("camera.yaml", "groundtruth.txt", "detections.json"):
+    if not os.path.isfile(os.path.join(fr3, name)):
+        sys.exit("%s: the fr3 folder %s has no %s (ELLRELOC_FR3 names another folder of the first half's layout)" %
+                 (sys.argv[0], fr3, name))
 
 
 def run(*args):
@@ -94,7 +105,6 @@ def main():
                        ["--map-up", "0,-1,0", "--max-tilt", "90"]),
                       ("ours, upright camera, every pose",
                        ["--map-up", "0,-1,0", "--max-tilt", "90", "--accept-all"])]))
-        fr3 = os.path.join(data, "tum_fr3_office_first_half")
         camera, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
         frames = json.load(open(os.path.join(fr3, "detections.json")))
         for name, (mapping, query) in table_splits(frames).items():

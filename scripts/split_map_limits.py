@@ -23,7 +23,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from fr3_splits import splits  # noqa: E402
-from real_data import box_map, data, relocalize  # noqa: E402
+from real_data import box_map, data, fr3, relocalize  # noqa: E402
 
 import ellreloc  # noqa: E402
 
@@ -66,7 +66,6 @@ def box_by_box(split_map, whole_map, camera, frames, whole_json, split_json):
 
 def main():
     warnings.simplefilter("ignore", UserWarning)  # read_map names the objects it leaves out
-    fr3 = os.path.join(data, "tum_fr3_office_first_half")
     camera_path, groundtruth = os.path.join(fr3, "camera.yaml"), os.path.join(fr3, "groundtruth.txt")
     frames = json.load(open(os.path.join(fr3, "detections.json")))
     camera, trajectory = ellreloc.read_camera(camera_path), ellreloc.read_trajectory(groundtruth)
