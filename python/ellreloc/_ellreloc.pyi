@@ -628,6 +628,7 @@ class SearchOptions:
     sampler: HypothesisSampler
     max_exhaustive_triplets: int
     correct_centres: bool
+    uncorrected_when_closer: bool
     check_sample_overlap: bool
     stop_when_explained: bool
     explained_mean_credit: float

@@ -176,6 +176,7 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("sampler", &SearchOptions::sampler)
       .def_readwrite("max_exhaustive_triplets", &SearchOptions::max_exhaustive_triplets)
       .def_readwrite("correct_centres", &SearchOptions::correct_centres)
+      .def_readwrite("uncorrected_when_closer", &SearchOptions::uncorrected_when_closer)
       .def_readwrite("check_sample_overlap", &SearchOptions::check_sample_overlap)
       .def_readwrite("stop_when_explained", &SearchOptions::stop_when_explained,
                      "end a sampled search once a pose explains every usable observation (at least four) well")

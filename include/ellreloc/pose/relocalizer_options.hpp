@@ -39,6 +39,12 @@ struct SearchOptions {
   /// observations (the triplets P3P is tried on).
   long max_exhaustive_triplets = 1000;
   bool correct_centres = true;  ///< re-solve P3P with the projected-centre offset removed
+  /// In a sampled search (Uniform, Prosac), a P3P pose stays uncorrected when its correction
+  /// fits the sample's own three observations worse (their W2^2 over the observed ellipse's
+  /// size, as the refiner weighs a match) or fails the sample check where it passes: the
+  /// correction now and then carries a pose to another P3P root, and a triplet drawn by chance
+  /// may not be drawn again. An enumeration tries every triplet and keeps the corrected pose.
+  bool uncorrected_when_closer = true;
   /// Drop a pose when one of its own three pairs overlaps less than scoring.min_overlap: a
   /// wrong triplet rarely fits the three shapes, and this costs three overlaps, not a map.
   bool check_sample_overlap = true;
@@ -179,6 +185,7 @@ struct RelocalizerOptions {
     RelocalizerOptions o;
     o.search.sampler = HypothesisSampler::Exhaustive;
     o.search.correct_centres = false;
+    o.search.uncorrected_when_closer = false;
     o.search.check_sample_overlap = false;
     o.search.stop_when_explained = false;
     o.search.refine_explained = false;

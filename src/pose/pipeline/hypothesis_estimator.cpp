@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "ellreloc/core/distances.hpp"
 #include "ellreloc/core/p3p.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/pose/few_object_poses.hpp"
@@ -19,6 +20,15 @@ EllipseMatch ellipseMatchOf(const CandidatePair& pair, const std::vector<Observa
 }
 
 }  // namespace
+
+HypothesisSampler frameSampler(const Candidates& candidates, const SearchOptions& search) {
+  if (search.sampler != HypothesisSampler::Auto) return search.sampler;
+  // What enumerating costs is the triplets of distinct observations, not all n choose 3
+  // triplets of pairs (most repeat an observation and are dropped at once).
+  return usableTriplets(candidates) <= static_cast<double>(search.max_exhaustive_triplets)
+             ? HypothesisSampler::Exhaustive
+             : HypothesisSampler::Prosac;
+}
 
 EllipseMatch refinerMatch(const Observation& o, const Ellipsoid& e, const RefinementStageOptions& options) {
   const bool regular_fit = o.source == EllipseSource::Mask && o.regular.value_or(false);
@@ -79,10 +89,32 @@ int HypothesisEstimator::generate(const int* s, Model* models) const {
     // and the projections. A correction moves a pose far less than the factor 1 / min_overlap in
     // area that this tolerates; the few poses it would carry past it jump to another P3P root.
     if (options_.search.check_sample_overlap && !ownSizesMayFit(m.pose, s)) continue;
+    if (sampled_ && options_.search.correct_centres && options_.search.uncorrected_when_closer) {
+      if (correctedOrNot(s, &m)) models[count++] = m;
+      continue;
+    }
     if (options_.search.correct_centres && !correctCentres(s, &m.pose)) continue;
     if (accept(m.pose, s, 3, options_.search.check_sample_overlap, &m.own)) models[count++] = m;
   }
   return count;
+}
+
+bool HypothesisEstimator::correctedOrNot(const int* s, Model* model) const {
+  const bool check = options_.search.check_sample_overlap;
+  Model corrected = *model;
+  const bool corrected_ok = correctCentres(s, &corrected.pose) && accept(corrected.pose, s, 3, check, &corrected.own);
+  const bool plain_ok = accept(model->pose, s, 3, check, &model->own);
+  if (corrected_ok && (!plain_ok || ownFit(s, corrected.own) <= ownFit(s, model->own))) *model = corrected;
+  return corrected_ok || plain_ok;
+}
+
+double HypothesisEstimator::ownFit(const int* s, const KnownProjections& own) const {
+  double sum = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const Ellipse& observed = observations_[static_cast<size_t>(pairs_[s[k]].observation)].ellipse;
+    sum += wasserstein2Squared(observed, own.ellipses[k]) / observed.axes().prod();
+  }
+  return sum;
 }
 
 bool HypothesisEstimator::ownSizesMayFit(const Pose& pose, const int* s) const {

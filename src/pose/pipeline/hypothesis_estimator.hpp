@@ -35,6 +35,10 @@ inline double explainedCost(const SearchOptions& search, int num_usable) {
   return num_usable * (1.0 - search.explained_mean_credit);
 }
 
+/// The sampler a frame's triplet search uses: options.search.sampler, Auto resolved by the
+/// number of usable triplets (at most max_exhaustive_triplets: Exhaustive, else Prosac).
+HypothesisSampler frameSampler(const Candidates& candidates, const SearchOptions& search);
+
 /// The pair the refiner reads for a match: an ellipse fitted to a regular mask weighs by
 /// `regular_mask_sigma` (RefinementStageOptions), any other ellipse by 1.
 EllipseMatch refinerMatch(const Observation& o, const Ellipsoid& e, const RefinementStageOptions& options);
@@ -64,7 +68,8 @@ class HypothesisEstimator {
         gate_(gate),
         scorer_(scorer),
         pool_(pool),
-        num_usable_(candidates.num_usable) {}
+        num_usable_(candidates.num_usable),
+        sampled_(frameSampler(candidates, options.search) != HypothesisSampler::Exhaustive) {}
 
   // The RANSAC estimator concept (core/ransac.hpp) over candidate pairs.
   size_t numData() const { return pairs_.size(); }
@@ -93,6 +98,12 @@ class HypothesisEstimator {
   /// observation by scoring.min_overlap (PoseScorer::sizeMayReach).
   bool ownSizesMayFit(const Pose& pose, const int* sample) const;
   bool correctCentres(const int* pair_indices, Pose* pose) const;
+  /// search.uncorrected_when_closer: `model` (a P3P pose) or its centre correction, whichever
+  /// passes the sample check and fits the sample's own observations closer; false when neither
+  /// passes.
+  bool correctedOrNot(const int* sample, Model* model) const;
+  /// The sum over a sample's own pairs of W2^2 over the observed ellipse's axes product.
+  double ownFit(const int* sample, const KnownProjections& own) const;
   void fromSolver(const std::vector<ScoredPose>& poses, const int* pair_indices, int count,
                   std::vector<Model>* out) const;
 
@@ -105,6 +116,7 @@ class HypothesisEstimator {
   PoseScorer& scorer_;
   const HypothesisPool* pool_;
   int num_usable_;
+  bool sampled_;  // the frame's triplets are sampled, not enumerated
 };
 
 }  // namespace ellreloc::pipeline

@@ -23,14 +23,7 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
                     const RelocalizerOptions& options, const FrameBudget& frame, HypothesisPool* pool,
                     SearchOutcome* outcome) {
   const int n = static_cast<int>(estimators.front()->numData());
-  HypothesisSampler sampler = options.search.sampler;
-  if (sampler == HypothesisSampler::Auto) {
-    // What enumerating costs is the triplets of distinct observations, not all n choose 3
-    // triplets of pairs (most repeat an observation and are dropped at once).
-    const double triplets = usableTriplets(candidates);
-    sampler = triplets <= static_cast<double>(options.search.max_exhaustive_triplets) ? HypothesisSampler::Exhaustive
-                                                                                      : HypothesisSampler::Prosac;
-  }
+  const HypothesisSampler sampler = frameSampler(candidates, options.search);
   RansacOptions budget = options.search.budget;
   budget.max_hypotheses = frame.max_hypotheses;
   if (frame.max_time_ms > 0.0) {  // what the frame's clock has left (0 would mean no bound)
