@@ -181,7 +181,7 @@ TEST(Cli, Fr2DeskKeyframesStayAboveTheMeasuredFloor) {
 }
 
 // Wrong poses on real data are ambiguous ones: asking for a margin over the best rival drops
-// most of them and few valid ones (measured 106 valid and 3 wrong of 198 at 0.3, against 122 and
+// most of them and few valid ones (measured 108 valid and 3 wrong of 198 at 0.3, against 122 and
 // 14 without; docs/reliability.md).
 TEST(Cli, Fr2DeskKeyframesWithAMargin) {
   const EvaluateRow f = fr2DeskFigures("--min-margin 0.3");
@@ -191,7 +191,7 @@ TEST(Cli, Fr2DeskKeyframesWithAMargin) {
 
 // For a host that checks poses with its points: the report lists the other answers found, and on
 // the fr2_desk keyframes one of them is valid where the pose is not in a few frames (measured,
-// every pose reported: the pose 138, the pose or the rival 146, the pose or an alternative 151).
+// every pose reported: the pose 138, the pose or the rival 147, the pose or an alternative 151).
 TEST(Cli, Fr2DeskKeyframesReportTheOtherAnswers) {
   ellreloc::test::TempDir dir;
   const std::string d = data("tum_fr2_desk");

@@ -116,7 +116,7 @@ TEST(HypothesisEstimator, ASampledSearchKeepsTheUncorrectedPoseWhenItFitsItsSamp
     while (s.observations.size() < 5) s = test::randomObservedScene(12, 3, 1.0, 3.0, K, rng);
     RelocalizerOptions sampled, corrected, enumerated;
     sampled.search.sampler = corrected.search.sampler = HypothesisSampler::Prosac;
-    corrected.search.uncorrected_when_closer = false;
+    sampled.search.uncorrected_when_closer = true;
     enumerated.search.sampler = HypothesisSampler::Exhaustive;
     std::vector<std::pair<int, std::string>> skipped;
     const pipeline::Candidates candidates =

@@ -44,7 +44,9 @@ struct SearchOptions {
   /// size, as the refiner weighs a match) or fails the sample check where it passes: the
   /// correction now and then carries a pose to another P3P root, and a triplet drawn by chance
   /// may not be drawn again. An enumeration tries every triplet and keeps the corrected pose.
-  bool uncorrected_when_closer = true;
+  /// Off by default: on real frames it finds a few more poses for about a sixth more time
+  /// (docs/pose.md, options).
+  bool uncorrected_when_closer = false;
   /// Drop a pose when one of its own three pairs overlaps less than scoring.min_overlap: a
   /// wrong triplet rarely fits the three shapes, and this costs three overlaps, not a map.
   bool check_sample_overlap = true;
@@ -185,7 +187,6 @@ struct RelocalizerOptions {
     RelocalizerOptions o;
     o.search.sampler = HypothesisSampler::Exhaustive;
     o.search.correct_centres = false;
-    o.search.uncorrected_when_closer = false;
     o.search.check_sample_overlap = false;
     o.search.stop_when_explained = false;
     o.search.refine_explained = false;
