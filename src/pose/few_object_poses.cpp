@@ -11,12 +11,14 @@ namespace ellreloc {
 
 namespace {
 
-/// The image of an ellipsoid given in the camera frame: centre x, shape matrix M = R diag(a^2)
-/// R^T turned into the camera. Its dual conic is K (M - x x^T) K^T (P Q* P^T for P = K [R | t],
-/// written without the world), an ellipse when the ellipsoid lies strictly in front of the
-/// principal plane (x_z > 0 and M_zz < x_z^2, as projectPrepared tells it). The sweeps place
-/// each object at many depths for one rotation: M is computed once for all of them.
-std::optional<Ellipse> imageInCameraFrame(const Eigen::Matrix3d& M, const Eigen::Vector3d& x, const Intrinsics& K) {
+/// The dual conic of the image of an ellipsoid given in the camera frame: centre x, shape
+/// matrix M = R diag(a^2) R^T turned into the camera. It is K (M - x x^T) K^T (P Q* P^T for
+/// P = K [R | t], written without the world), an ellipse when the ellipsoid lies strictly in
+/// front of the principal plane (x_z > 0 and M_zz < x_z^2, as projectPrepared tells it), else
+/// nullopt. The sweeps place each object at many depths for one rotation: M is computed once
+/// for all of them.
+std::optional<Eigen::Matrix3d> dualConicInCameraFrame(const Eigen::Matrix3d& M, const Eigen::Vector3d& x,
+                                                      const Intrinsics& K) {
   if (!x.allFinite()) return std::nullopt;
   const Eigen::Matrix3d N = M - x * x.transpose();
   if (!(x(2) > 0.0 && N(2, 2) < 0.0)) return std::nullopt;
@@ -29,7 +31,38 @@ std::optional<Ellipse> imageInCameraFrame(const Eigen::Matrix3d& M, const Eigen:
   C(0, 2) = C(2, 0) = u;
   C(1, 2) = C(2, 1) = v;
   C(2, 2) = N(2, 2);
-  return Ellipse::fromDualConic(C);
+  return C;
+}
+
+std::optional<Ellipse> imageInCameraFrame(const Eigen::Matrix3d& M, const Eigen::Vector3d& x, const Intrinsics& K) {
+  const std::optional<Eigen::Matrix3d> C = dualConicInCameraFrame(M, x, K);
+  return C ? Ellipse::fromDualConic(*C) : std::nullopt;
+}
+
+/// What placing an object needs of its image: the centre and sqrt(a b), the geometric mean of
+/// the semi-axes (from the determinant of the image's covariance, with no axes or angle).
+struct ImageCentreAndSize {
+  Eigen::Vector2d centre;
+  double size;
+};
+
+/// imageInCameraFrame's centre and size, nullopt exactly where it has no ellipse.
+std::optional<ImageCentreAndSize> imageCentreAndSize(const Eigen::Matrix3d& M, const Eigen::Vector3d& x,
+                                                     const Intrinsics& K) {
+  const std::optional<Eigen::Matrix3d> C = dualConicInCameraFrame(M, x, K);
+  if (!C || !C->allFinite()) return std::nullopt;
+  const double scale = C->cwiseAbs().maxCoeff();
+  if (!(scale > 0.0) || std::abs((*C)(2, 2)) <= 1e-14 * scale) return std::nullopt;
+  Eigen::Vector2d mean;
+  Eigen::Matrix2d cov;
+  gaussianFromDualConic<double>(*C, &mean, &cov);
+  if (!mean.allFinite() || !cov.allFinite()) return std::nullopt;
+  // Ellipse::fromGaussian's test of a positive definite covariance, on its eigenvalues.
+  const double half_trace = 0.5 * (cov(0, 0) + cov(1, 1)), half_diff = 0.5 * (cov(0, 0) - cov(1, 1));
+  const double radius = std::sqrt(half_diff * half_diff + cov(0, 1) * cov(0, 1));
+  const double l1 = half_trace + radius, l2 = half_trace - radius;
+  if (!(l2 > 0.0) || !(l2 > 1e-12 * l1)) return std::nullopt;
+  return ImageCentreAndSize{mean, std::sqrt(std::sqrt(l1 * l2))};
 }
 
 /// placeObject for a prepared, valid ellipsoid and a rotation; `M`: its shape matrix in the
@@ -45,23 +78,23 @@ std::optional<Eigen::Vector3d> placePrepared(const Intrinsics& K, const Eigen::M
   Eigen::Matrix2d S;
   S << u.dot(M * u), u.dot(M * v), v.dot(M * u), v.dot(M * v);
   const double focal = std::sqrt(K.fx * K.fy);
-  double depth = focal * std::pow(std::max(S.determinant(), 0.0), 0.25) / observed_size;
+  double depth = focal * std::sqrt(std::sqrt(std::max(S.determinant(), 0.0))) / observed_size;
   depth = std::max(depth, 1.01 * e.axes().maxCoeff());  // the camera stays outside
   // Perspective: the image size goes as 1 / depth near the answer, and the centre of the
   // projected ellipse is not the projection of the centre; a few fixed-point steps fix both.
   // The ellipsoid's centre is at depth x bearing in the camera.
   for (int iteration = 0; iteration < 4; ++iteration) {
-    const std::optional<Ellipse> image = imageInCameraFrame(M, depth * bearing, K);
+    const std::optional<ImageCentreAndSize> image = imageCentreAndSize(M, depth * bearing, K);
     if (!image) {
       depth *= 2.0;  // too close: the ellipsoid reaches behind the principal plane
       continue;
     }
-    const Eigen::Vector2d offset = image->center() - K.project(depth * bearing);
-    depth *= std::sqrt(image->axes().prod()) / observed_size;
+    const Eigen::Vector2d offset = image->centre - K.project(depth * bearing);
+    depth *= image->size / observed_size;
     bearing = K.bearing(observed.center() - offset);
   }
   const Eigen::Vector3d t = depth * bearing - R_cw * e.center();
-  if (!t.allFinite() || !imageInCameraFrame(M, depth * bearing, K)) return std::nullopt;
+  if (!t.allFinite() || !imageCentreAndSize(M, depth * bearing, K)) return std::nullopt;
   return t;
 }
 

@@ -5,6 +5,7 @@
 #include <ceres/rotation.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 
@@ -162,8 +163,11 @@ Pose applyDelta(const Pose& pose, const Vec6& d) {
   double R[9];
   ceres::AngleAxisToRotationMatrix(d.data(), ceres::RowMajorAdapter3x3(R));
   const Eigen::Matrix3d dR = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R);
-  // Re-orthonormalise: many small rotations accumulate rounding.
-  return Pose(nearestRotation(dR * pose.rotation()), dR * pose.translation() + d.tail<3>());
+  // Re-orthonormalise: many small rotations accumulate rounding. The product of two rotations
+  // is one to rounding, so its unit quaternion is as good as the nearest rotation and far cheaper
+  // than an SVD.
+  const Eigen::Quaterniond q(Eigen::Matrix3d(dR * pose.rotation()));
+  return Pose(q.normalized().toRotationMatrix(), dR * pose.translation() + d.tail<3>());
 }
 
 /// Ceres cost of one ellipse-ellipsoid match: the normalised 6-vector W2 residual at the pose
@@ -297,10 +301,15 @@ Pose solveWithLevenbergMarquardt(const Problem& problem, const Pose& initial, co
       Mat6 A = H;
       A.diagonal() += lambda * (H.diagonal().cwiseMax(1e-9));
       const Vec6 step = -A.ldlt().solve(g);
+      if (!step.allFinite()) {
+        lambda *= 10.0;
+        continue;
+      }
+      const Pose trial = applyDelta(pose, step);
       double trial_cost;
-      if (step.allFinite() && problem.cost(applyDelta(pose, step), &trial_cost) && trial_cost < cost) {
+      if (problem.cost(trial, &trial_cost) && trial_cost < cost) {
         const double decrease = cost - trial_cost;
-        pose = applyDelta(pose, step);
+        pose = trial;
         cost = trial_cost;
         lambda = std::max(lambda / 10.0, 1e-12);
         accepted = true;
