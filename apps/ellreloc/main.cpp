@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
   CLI::App app("ellreloc: object-based camera relocalization with ellipses and ellipsoids", "ellreloc");
   app.require_subcommand(1);
   Console console;
-  app.add_flag("-q,--quiet", console.quiet, "print nothing but results and errors");
+  app.add_flag("-q,--quiet", console.quiet, "print nothing but results and errors (before or after the subcommand)");
+  app.fallthrough();  // subcommands, added below, pass -q on to the app whichever side of them it is
   app.footer("Run `ellreloc SUBCOMMAND --help` for a subcommand's options and an example.");
   app.set_version_flag("--version", "ellreloc " ELLRELOC_VERSION, "print the version and exit");
 

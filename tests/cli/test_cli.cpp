@@ -352,6 +352,28 @@ TEST(Cli, OutputsNeverClobberInputsAndOnlyRegularFilesAreRead) {
   EXPECT_TRUE(fs::is_symlink(dir.path("detections_symlink.json")));
 }
 
+// `-q` silences the progress lines wherever it is given, before the subcommand or among its
+// options, and changes nothing in what is written.
+TEST(Cli, QuietBeforeOrAfterTheSubcommand) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr2_desk");
+  const std::string args = "relocalize --camera " + d + "/camera.yaml --map " + d + "/map.json --detections " + d +
+                           "/keyframes.detections.json --threads 2 --out " + dir.path("poses.txt");
+  const CliRun loud = run(args, dir);
+  ASSERT_EQ(loud.code, 0) << loud.err;
+  EXPECT_NE(loud.out.find("wrote "), std::string::npos) << loud.out;
+  const std::string poses = readFile(dir.path("poses.txt"));
+  ASSERT_FALSE(poses.empty());
+  for (const std::string& quiet : {"-q " + args, args + " -q", "relocalize --quiet" + args.substr(10)}) {
+    fs::remove(dir.path("poses.txt"));
+    const CliRun r = run(quiet, dir);
+    EXPECT_EQ(r.code, 0) << quiet << ": " << r.err;
+    EXPECT_EQ(r.out, "") << quiet;
+    EXPECT_EQ(r.err, "") << quiet;
+    EXPECT_EQ(readFile(dir.path("poses.txt")), poses) << quiet;
+  }
+}
+
 TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
   ellreloc::test::TempDir dir;
   const std::string d = data("tum_fr2_desk");
