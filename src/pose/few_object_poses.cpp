@@ -39,30 +39,12 @@ std::optional<Ellipse> imageInCameraFrame(const Eigen::Matrix3d& M, const Eigen:
   return C ? Ellipse::fromDualConic(*C) : std::nullopt;
 }
 
-/// What placing an object needs of its image: the centre and sqrt(a b), the geometric mean of
-/// the semi-axes (from the determinant of the image's covariance, with no axes or angle).
-struct ImageCentreAndSize {
-  Eigen::Vector2d centre;
-  double size;
-};
-
-/// imageInCameraFrame's centre and size, nullopt exactly where it has no ellipse.
-std::optional<ImageCentreAndSize> imageCentreAndSize(const Eigen::Matrix3d& M, const Eigen::Vector3d& x,
-                                                     const Intrinsics& K) {
+/// imageInCameraFrame's centre and size (Ellipse::centreAndSizeFromDualConic), nullopt exactly
+/// where it has no ellipse.
+std::optional<Ellipse::CentreAndSize> imageCentreAndSize(const Eigen::Matrix3d& M, const Eigen::Vector3d& x,
+                                                         const Intrinsics& K) {
   const std::optional<Eigen::Matrix3d> C = dualConicInCameraFrame(M, x, K);
-  if (!C || !C->allFinite()) return std::nullopt;
-  const double scale = C->cwiseAbs().maxCoeff();
-  if (!(scale > 0.0) || std::abs((*C)(2, 2)) <= 1e-14 * scale) return std::nullopt;
-  Eigen::Vector2d mean;
-  Eigen::Matrix2d cov;
-  gaussianFromDualConic<double>(*C, &mean, &cov);
-  if (!mean.allFinite() || !cov.allFinite()) return std::nullopt;
-  // Ellipse::fromGaussian's test of a positive definite covariance, on its eigenvalues.
-  const double half_trace = 0.5 * (cov(0, 0) + cov(1, 1)), half_diff = 0.5 * (cov(0, 0) - cov(1, 1));
-  const double radius = std::sqrt(half_diff * half_diff + cov(0, 1) * cov(0, 1));
-  const double l1 = half_trace + radius, l2 = half_trace - radius;
-  if (!(l2 > 0.0) || !(l2 > 1e-12 * l1)) return std::nullopt;
-  return ImageCentreAndSize{mean, std::sqrt(std::sqrt(l1 * l2))};
+  return C ? Ellipse::centreAndSizeFromDualConic(*C) : std::nullopt;
 }
 
 /// placeObject for a prepared, valid ellipsoid and a rotation; `M`: its shape matrix in the
@@ -84,7 +66,7 @@ std::optional<Eigen::Vector3d> placePrepared(const Intrinsics& K, const Eigen::M
   // projected ellipse is not the projection of the centre; a few fixed-point steps fix both.
   // The ellipsoid's centre is at depth x bearing in the camera.
   for (int iteration = 0; iteration < 4; ++iteration) {
-    const std::optional<ImageCentreAndSize> image = imageCentreAndSize(M, depth * bearing, K);
+    const std::optional<Ellipse::CentreAndSize> image = imageCentreAndSize(M, depth * bearing, K);
     if (!image) {
       depth *= 2.0;  // too close: the ellipsoid reaches behind the principal plane
       continue;

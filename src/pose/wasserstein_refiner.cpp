@@ -301,20 +301,18 @@ Pose solveWithLevenbergMarquardt(const Problem& problem, const Pose& initial, co
       Mat6 A = H;
       A.diagonal() += lambda * (H.diagonal().cwiseMax(1e-9));
       const Vec6 step = -A.ldlt().solve(g);
-      if (!step.allFinite()) {
-        lambda *= 10.0;
-        continue;
-      }
-      const Pose trial = applyDelta(pose, step);
-      double trial_cost;
-      if (problem.cost(trial, &trial_cost) && trial_cost < cost) {
-        const double decrease = cost - trial_cost;
-        pose = trial;
-        cost = trial_cost;
-        lambda = std::max(lambda / 10.0, 1e-12);
-        accepted = true;
-        if (decrease <= options.function_tolerance * (cost + 1e-12)) *converged = true;
-        break;
+      if (step.allFinite()) {
+        const Pose trial = applyDelta(pose, step);
+        double trial_cost;
+        if (problem.cost(trial, &trial_cost) && trial_cost < cost) {
+          const double decrease = cost - trial_cost;
+          pose = trial;
+          cost = trial_cost;
+          lambda = std::max(lambda / 10.0, 1e-12);
+          accepted = true;
+          if (decrease <= options.function_tolerance * (cost + 1e-12)) *converged = true;
+          break;
+        }
       }
       lambda *= 10.0;
     }

@@ -33,6 +33,31 @@ TEST(Ellipse, DualConicRoundTripAtAnyScaleAndSign) {
   }
 }
 
+// The centre and size alone, for callers that need no axes or angle: the centre and
+// sqrt(a b) of the ellipse the conic describes, and nothing exactly where fromDualConic gives
+// nothing.
+TEST(Ellipse, CentreAndSizeFromDualConicAgreeWithTheEllipse) {
+  std::mt19937 rng(7);
+  for (int i = 0; i < 500; ++i) {
+    const Ellipse e = ellreloc::test::randomEllipse(rng);
+    const double scale = (i % 2 ? -1.0 : 1.0) * std::pow(10.0, uniform(rng, -6, 6));
+    const auto cs = Ellipse::centreAndSizeFromDualConic(scale * e.dualConic());
+    ASSERT_TRUE(cs.has_value());
+    EXPECT_LT((cs->centre - e.center()).norm(), 1e-9 * (1.0 + e.center().norm()));
+    EXPECT_NEAR(cs->size, std::sqrt(e.axes()(0) * e.axes()(1)), 1e-9 * e.axes()(0));
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Matrix3d with_nan = Ellipse({1, 2}, {3, 2}, 0.3).dualConic(), parabola = with_nan;
+  with_nan(0, 1) = nan;
+  parabola(2, 2) = 0.0;
+  for (const Eigen::Matrix3d& C : {with_nan, parabola, Eigen::Matrix3d(Eigen::Matrix3d::Zero()),
+                                   Eigen::Matrix3d(Eigen::Vector3d(1, -1, -1).asDiagonal()),
+                                   Eigen::Matrix3d(Eigen::Matrix3d::Identity())}) {
+    EXPECT_FALSE(Ellipse::fromDualConic(C).has_value());
+    EXPECT_FALSE(Ellipse::centreAndSizeFromDualConic(C).has_value());
+  }
+}
+
 TEST(Ellipse, GaussianRoundTrip) {
   std::mt19937 rng(2);
   for (int i = 0; i < 500; ++i) {

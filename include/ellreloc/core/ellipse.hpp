@@ -70,25 +70,34 @@ class Ellipse {
   /// Returns nullopt when the matrix is not finite or does not describe a real ellipse.
   /// The result has a >= b and angle in (-pi/2, pi/2].
   static std::optional<Ellipse> fromDualConic(const Eigen::Matrix3d& C) {
-    if (!C.allFinite()) return std::nullopt;
-    const double scale = C.cwiseAbs().maxCoeff();
-    if (!(scale > 0.0) || std::abs(C(2, 2)) <= 1e-14 * scale) return std::nullopt;
     Eigen::Vector2d mean;
     Eigen::Matrix2d cov;
-    gaussianFromDualConic<double>(C, &mean, &cov);
+    if (!gaussianOfDualConic(C, &mean, &cov)) return std::nullopt;
     return fromGaussian(mean, cov);
+  }
+
+  /// The centre and sqrt(a b) of fromDualConic(C)'s ellipse, nullopt exactly where it has none,
+  /// without its axes or angle: what placing an object at a depth needs, many times over.
+  struct CentreAndSize {
+    Eigen::Vector2d centre;
+    double size;
+  };
+  static std::optional<CentreAndSize> centreAndSizeFromDualConic(const Eigen::Matrix3d& C) {
+    Eigen::Vector2d mean;
+    Eigen::Matrix2d cov;
+    if (!gaussianOfDualConic(C, &mean, &cov) || !mean.allFinite() || !cov.allFinite()) return std::nullopt;
+    const std::optional<Eigenvalues> e = positiveEigenvalues(cov);
+    if (!e) return std::nullopt;
+    return CentreAndSize{mean, std::sqrt(std::sqrt(e->l1 * e->l2))};
   }
 
   /// The ellipse whose Gaussian has this mean and covariance (covariance must be positive
   /// definite). The result has a >= b and angle in (-pi/2, pi/2].
   static std::optional<Ellipse> fromGaussian(const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov) {
     if (!mean.allFinite() || !cov.allFinite()) return std::nullopt;
-    const double p = cov(0, 0), r = cov(1, 1), q = 0.5 * (cov(0, 1) + cov(1, 0));
-    // Closed-form eigen decomposition of a symmetric 2x2 matrix.
-    const double half_trace = 0.5 * (p + r), half_diff = 0.5 * (p - r);
-    const double radius = scaledNorm(half_diff, q);
-    const double l1 = half_trace + radius, l2 = half_trace - radius;
-    if (!(l2 > 0.0) || !(l2 > 1e-12 * l1)) return std::nullopt;
+    const std::optional<Eigenvalues> e = positiveEigenvalues(cov);
+    if (!e) return std::nullopt;
+    const double half_diff = e->half_diff, radius = e->radius, q = e->q;
     // Axis a is the eigenvector of l1: (l1 - r, q) = (half_diff + radius, q), or (q, l1 - p) =
     // (q, radius - half_diff), whichever has no cancellation, turned so that the angle is in
     // (-pi/2, pi/2] (cosine > 0, or 0 with sine > 0). Projections make ellipses by the thousand
@@ -100,7 +109,7 @@ class Ellipse {
       c = q < 0.0 ? -q : q, s = q < 0.0 ? half_diff - radius : radius - half_diff;
     }
     const double norm = scaledNorm(c, s);
-    return Ellipse(mean, Eigen::Vector2d(std::sqrt(l1), std::sqrt(l2)), c / norm, s / norm);
+    return Ellipse(mean, Eigen::Vector2d(std::sqrt(e->l1), std::sqrt(e->l2)), c / norm, s / norm);
   }
 
   /// The ellipse inscribed in an axis-aligned box (OA-SLAM's observation model).
@@ -185,6 +194,31 @@ class Ellipse {
   }
 
  private:
+  /// The Gaussian of a dual conic (gaussianFromDualConic); false when C is not finite or
+  /// C(2,2) vanishes (no finite centre).
+  static bool gaussianOfDualConic(const Eigen::Matrix3d& C, Eigen::Vector2d* mean, Eigen::Matrix2d* cov) {
+    if (!C.allFinite()) return false;
+    const double scale = C.cwiseAbs().maxCoeff();
+    if (!(scale > 0.0) || std::abs(C(2, 2)) <= 1e-14 * scale) return false;
+    gaussianFromDualConic<double>(C, mean, cov);
+    return true;
+  }
+
+  /// The closed-form eigen decomposition of a symmetric 2x2 covariance [p q; q r]: eigenvalues
+  /// l1 >= l2 = (p + r) / 2 +- radius, radius = |((p - r) / 2, q)|.
+  struct Eigenvalues {
+    double l1, l2, half_diff, radius, q;
+  };
+  /// Nullopt unless the covariance is positive definite (l2 > 0, and not degenerate next to l1).
+  static std::optional<Eigenvalues> positiveEigenvalues(const Eigen::Matrix2d& cov) {
+    const double p = cov(0, 0), r = cov(1, 1), q = 0.5 * (cov(0, 1) + cov(1, 0));
+    const double half_trace = 0.5 * (p + r), half_diff = 0.5 * (p - r);
+    const double radius = scaledNorm(half_diff, q);
+    const double l1 = half_trace + radius, l2 = half_trace - radius;
+    if (!(l2 > 0.0) || !(l2 > 1e-12 * l1)) return std::nullopt;
+    return Eigenvalues{l1, l2, half_diff, radius, q};
+  }
+
   /// sqrt(x^2 + y^2) without overflow or underflow at any finite scale (as std::hypot, cheaper).
   static double scaledNorm(double x, double y) {
     const double m = std::max(std::abs(x), std::abs(y));
