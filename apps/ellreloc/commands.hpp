@@ -11,6 +11,7 @@
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/observe/observe.hpp"
+#include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
 #include "figure.hpp"
 
@@ -82,6 +83,11 @@ struct RelocalizeArgs {
   std::vector<double> camera_up, map_up;
   double gravity_sigma_deg = 2.0;
   std::string overlays;  ///< a folder for one PNG per frame (io/overlay.hpp); empty: none
+  /// TUM poses the camera was last tracked at: each frame is searched within near_radius_m and
+  /// near_angle_deg of the latest one at or before its timestamp (a PoseRegion); empty: none.
+  std::string near;
+  double near_radius_m = PoseRegion().radius_m;
+  double near_angle_deg = PoseRegion().max_rotation_deg;
 };
 /// `use_points` is set after parsing, from whether --points was given.
 CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a);

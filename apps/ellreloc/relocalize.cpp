@@ -110,6 +110,19 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
   r->add_option("--gravity-sigma", a.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
       ->capture_default_str()
       ->needs(camera_up);
+  auto* near = r->add_option("--near", a.near,
+                             "TUM poses (camera->world) where the camera was last tracked: each frame is searched "
+                             "only near the latest one at or before its timestamp (--near-radius, --near-angle); "
+                             "frames before the first are searched everywhere")
+                   ->check(CLI::ExistingFile);
+  r->add_option("--near-radius", a.near_radius_m, "with --near: how far the camera can have moved, in metres")
+      ->capture_default_str()
+      ->needs(near);
+  r->add_option("--near-angle", a.near_angle_deg,
+                "with --near: how far the camera can have turned, in degrees (180: any way)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 180.0))
+      ->needs(near);
   r->footer(
       "Example: ellreloc relocalize --camera camera.yaml --map map.json --detections keyframes.detections.json "
       "--method ours --out poses.txt --report report.json --threads 2");
@@ -128,7 +141,7 @@ struct ReferenceScore {
 std::vector<RelocalizationResult> relocalizeFrames(
     const ObjectRelocalizer& relocalizer, const std::vector<DetectionFrame>& frames,
     const std::vector<std::vector<Keypoint>>& keypoints, const std::optional<GravityPrior>& gravity,
-    const ObserveOptions& observe_options, const std::vector<std::optional<Pose>>& references, int threads,
+    const std::vector<std::optional<PoseRegion>>& regions, const ObserveOptions& observe_options, const std::vector<std::optional<Pose>>& references, int threads,
     const Console& console, std::vector<std::vector<Observation>>* observations_out,
     std::vector<ReferenceScore>* reference_scores) {
   // Frames are independent: `threads` workers take the next frame until none is left (the
@@ -145,7 +158,7 @@ std::vector<RelocalizationResult> relocalizeFrames(
       for (size_t i = next++; i < frames.size() && !failed; i = next++) {
         const std::vector<Observation>& observations = (*observations_out)[i] =
             observeDetections(frames[i].detections, K.width, K.height, observe_options);
-        results[i] = relocalizer.relocalize(observations, keypoints[i], gravity);
+        results[i] = relocalizer.relocalize(observations, keypoints[i], gravity, regions[i]);
         if (references[i])
           (*reference_scores)[i] = {relocalizer.scorePose(observations, *references[i]),
                                     relocalizer.refineFrom(observations, *references[i])};
@@ -244,6 +257,33 @@ std::vector<double> frameTimestamps(const std::vector<DetectionFrame>& frames, c
     timestamps.push_back(*t);
   }
   return timestamps;
+}
+
+/// Each frame's --near region: about the latest --near pose at or before the frame's timestamp,
+/// none for a frame before the first; `without` counts those.
+std::vector<std::optional<PoseRegion>> nearRegions(const RelocalizeArgs& a, const std::vector<double>& timestamps,
+                                                   size_t* without) {
+  std::vector<std::optional<PoseRegion>> regions(timestamps.size());
+  *without = 0;
+  if (a.near.empty()) return regions;
+  if (!(a.near_radius_m > 0.0) || !std::isfinite(a.near_radius_m))
+    throw Error("--near-radius: expected a positive number of metres");
+  if (!(a.near_angle_deg > 0.0 && a.near_angle_deg <= 180.0))  // CLI11's range check lets NaN through
+    throw Error("--near-angle: expected a number of degrees in (0, 180]");
+  std::vector<io::StampedPose> tracked = io::readTumTrajectory(a.near);
+  std::stable_sort(tracked.begin(), tracked.end(),
+                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.timestamp < y.timestamp; });
+  for (size_t i = 0; i < timestamps.size(); ++i) {
+    // The last pose whose timestamp is not after the frame's (1 us for timestamps written alike).
+    const auto after = std::upper_bound(tracked.begin(), tracked.end(), timestamps[i] + 1e-6,
+                                        [](double t, const io::StampedPose& p) { return t < p.timestamp; });
+    if (after == tracked.begin()) {
+      ++*without;
+      continue;
+    }
+    regions[i] = PoseRegion{std::prev(after)->pose, a.near_radius_m, a.near_angle_deg};
+  }
+  return regions;
 }
 
 /// One frame's entry of the --report JSON (with its diagnosis against a reference pose).
@@ -354,7 +394,8 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
                                                           {"--detections", a.detections},
                                                           {"--points", a.points},
                                                           {"--reference", a.reference},
-                                                          {"--envelope", a.envelope}});
+                                                          {"--envelope", a.envelope},
+                                                          {"--near", a.near}});
   const Intrinsics K = io::readCamera(a.camera);
   std::vector<std::string> left_out;
   const ObjectMap object_map = io::readMap(a.map, &left_out);
@@ -363,6 +404,8 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const std::vector<double> timestamps = frameTimestamps(frames, a.detections);
   std::string policy = a.policy;
   const RelocalizerOptions options = relocalizerOptions(a, &policy);
+  size_t without_region = 0;
+  const std::vector<std::optional<PoseRegion>> regions = nearRegions(a, timestamps, &without_region);
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "solid" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
@@ -402,8 +445,8 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   std::vector<std::vector<Observation>> observations(frames.size());
   std::vector<ReferenceScore> reference_scores(frames.size());
   const std::vector<RelocalizationResult> results =
-      relocalizeFrames(relocalizer, frames, keypoints, gravity, observe_options, references, a.threads, console,
-                       &observations, &reference_scores);
+      relocalizeFrames(relocalizer, frames, keypoints, gravity, regions, observe_options, references, a.threads,
+                       console, &observations, &reference_scores);
   console.endProgress();
   std::map<std::string, int> diagnoses;
 
@@ -427,6 +470,8 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   if (!console.quiet)
     std::printf("wrote %s: %zu of %zu frames relocalized (%s), median %.1f ms per frame\n", a.out.c_str(), poses.size(),
                 frames.size(), a.method.c_str(), median(times));
+  if (without_region > 0 && !console.quiet)
+    std::printf("%zu frame(s) before the first pose of %s: searched everywhere\n", without_region, a.near.c_str());
   if (!a.reference.empty()) {  // a result: printed even when quiet
     std::printf("against %s:", a.reference.c_str());
     for (const auto& [diagnosis, count] : diagnoses) std::printf(" %s %d,", diagnosis.c_str(), count);

@@ -330,7 +330,7 @@ class ObjectMap:
 class ObjectRelocalizer:
     """Relocalizes query frames against a map of ellipsoids. Keyword groups set options: ObjectRelocalizer(map, camera, scoring={'min_overlap': 0.2}, acceptance={'enabled': False}). method='oa-slam' gives OA-SLAM's exhaustive baseline (with the 'bbox' policy)."""
     def __init__(self, map: ObjectMap, camera: Intrinsics, options: Optional[RelocalizerOptions] = ..., method: str = ..., policy: str | ObservationPolicy | None = ..., **groups: dict[str, Any] | CameraEnvelope | None) -> None: ...
-    def relocalize(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], keypoints: Sequence[Keypoint] | ArrayLike | None = ..., gravity: Optional[GravityPrior] = ...) -> RelocalizationResult: """Relocalizes one frame: a DetectionFrame (observed with this relocalizer's policy, its keypoints used unless `keypoints` is given), a list of Detection or a list of Observation. `keypoints`: Keypoint items or an (n, 3) array of (point_index, u, v). The GIL is released meanwhile."""
+    def relocalize(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], keypoints: Sequence[Keypoint] | ArrayLike | None = ..., gravity: Optional[GravityPrior] = ..., region: Optional[PoseRegion] = ...) -> RelocalizationResult: """Relocalizes one frame: a DetectionFrame (observed with this relocalizer's policy, its keypoints used unless `keypoints` is given), a list of Detection or a list of Observation. `keypoints`: Keypoint items or an (n, 3) array of (point_index, u, v); `gravity`: a GravityPrior; `region`: a PoseRegion (poses outside it are never hypotheses). The GIL is released meanwhile."""
     def relocalize_frames(self, frames: list[DetectionFrame], threads: int = ...) -> list[RelocalizationResult]: """Relocalizes many DetectionFrames in C++ on `threads` threads; the same results as relocalize() on each."""
     def observe(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection]) -> list[Observation]: """The observations relocalize() makes of a frame."""
     def score_pose(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], pose: Pose) -> RelocalizationResult: """Scores a pose from elsewhere the way relocalize() scores its hypotheses."""
@@ -441,6 +441,15 @@ class PoseError:
     position_cm: float
     rotation_deg: float
     valid: bool
+
+
+class PoseRegion:
+    """Where the camera is known to be: within radius_m and max_rotation_deg of `pose` (the last pose the host tracked, world->camera)."""
+    def __init__(self, pose: Pose, radius_m: float = ..., max_rotation_deg: float = ...) -> None: ...
+    pose: Pose
+    radius_m: float
+    max_rotation_deg: float
+    def admits(self, pose: Pose) -> bool: """Whether a world->camera pose lies in the region."""
 
 
 class RefinementOptions:

@@ -99,12 +99,13 @@ std::vector<Observation> observationsFrom(const Relocalizer& r, const py::handle
 }
 
 RelocalizationResult relocalizeOne(const Relocalizer& r, const py::handle& frame, const py::handle& keypoints,
-                                   const std::optional<GravityPrior>& gravity) {
+                                   const std::optional<GravityPrior>& gravity,
+                                   const std::optional<PoseRegion>& region) {
   std::vector<Keypoint> points;
   const std::vector<Observation> observations = observationsFrom(r, frame, &points);
   if (!keypoints.is_none()) points = keypointsFrom(keypoints);
   py::gil_scoped_release release;
-  return r.relocalizer.relocalize(observations, points, gravity);
+  return r.relocalizer.relocalize(observations, points, gravity, region);
 }
 
 std::vector<RelocalizationResult> relocalizeMany(const Relocalizer& r, const std::vector<DetectionFrame>& frames,
@@ -264,6 +265,22 @@ void bindPriors(py::module_& m) {
       .def_readonly("sigma_deg", &GravityPrior::sigma_deg)
       .def("error_deg", &GravityPrior::errorDeg, py::arg("pose"));
 
+  py::class_<PoseRegion>(m, "PoseRegion",
+                         "Where the camera is known to be: within radius_m and max_rotation_deg of `pose` (the last "
+                         "pose the host tracked, world->camera).")
+      .def(py::init([](const Pose& pose, double radius_m, double max_rotation_deg) {
+             const PoseRegion r{pose, radius_m, max_rotation_deg};
+             if (!r.isValid())
+               badArgument("PoseRegion", "expected a valid pose, a positive radius_m and max_rotation_deg in (0, 180]");
+             return r;
+           }),
+           py::arg("pose"), py::arg("radius_m") = PoseRegion().radius_m,
+           py::arg("max_rotation_deg") = PoseRegion().max_rotation_deg)
+      .def_readonly("pose", &PoseRegion::pose)
+      .def_readonly("radius_m", &PoseRegion::radius_m)
+      .def_readonly("max_rotation_deg", &PoseRegion::max_rotation_deg)
+      .def("admits", &PoseRegion::admits, py::arg("pose"), "Whether a world->camera pose lies in the region.");
+
   py::class_<CameraEnvelope>(m, "CameraEnvelope", "Where the camera can be: heights along `up` and tilts.")
       .def_static(
           "from_keyframes",
@@ -398,10 +415,11 @@ void bindRelocalizer(py::module_& m) {
       .def(py::init(&makeRelocalizer), py::arg("map"), py::arg("camera"), py::arg("options") = py::none(),
            py::arg("method") = "ours", py::arg("policy") = py::none())
       .def("relocalize", &relocalizeOne, py::arg("frame"), py::arg("keypoints") = py::none(),
-           py::arg("gravity") = py::none(),
+           py::arg("gravity") = py::none(), py::arg("region") = py::none(),
            "Relocalizes one frame: a DetectionFrame (observed with this relocalizer's policy, its keypoints used "
            "unless `keypoints` is given), a list of Detection or a list of Observation. `keypoints`: Keypoint "
-           "items or an (n, 3) array of (point_index, u, v). The GIL is released meanwhile.")
+           "items or an (n, 3) array of (point_index, u, v); `gravity`: a GravityPrior; `region`: a PoseRegion "
+           "(poses outside it are never hypotheses). The GIL is released meanwhile.")
       .def("relocalize_frames", &relocalizeMany, py::arg("frames"), py::arg("threads") = 1,
            "Relocalizes many DetectionFrames in C++ on `threads` threads; the same results as relocalize() on each.")
       .def(

@@ -29,6 +29,32 @@ def test_fr2_keyframes_give_exactly_the_command_line_poses(fr2, data_dir, cli, t
     assert ours.count(b"\n") > 90  # most keyframes relocalize
 
 
+def test_a_pose_region_gives_the_command_lines_near_poses(fr2, data_dir, cli, tmp_path):
+    """Each keyframe searched within 0.3 m and 20 degrees of the previous keyframe's true pose,
+    through Python and through `--near`; every pose lies in its region."""
+    camera, map_, frames = fr2
+    d = data_dir / "tum_fr2_desk"
+    truth = E.read_trajectory(d / "keyframes.groundtruth.txt")
+    nearest = lambda t: min(truth, key=lambda s: abs(s.timestamp - t)).pose
+    previous = [(f, nearest(p.timestamp)) for p, f in zip(frames, frames[1:])]
+    E.write_trajectory(tmp_path / "near.txt", [(f.timestamp_text, pose) for f, pose in previous])
+    subprocess.run([cli, "relocalize", "--camera", str(d / "camera.yaml"), "--map", str(d / "map.json"),
+                    "--detections", str(d / "keyframes.detections.json"), "--near", str(tmp_path / "near.txt"),
+                    "--near-radius", "0.3", "--near-angle", "20", "--out", str(tmp_path / "cli.txt")],
+                   check=True, capture_output=True)
+    relocalizer = E.ObjectRelocalizer(map_, camera)
+    # The poses as the command line reads them back (a rotation through text is not the same to the bit).
+    regions = [None] + [E.PoseRegion(s.pose, radius_m=0.3, max_rotation_deg=20)
+                        for s in E.read_trajectory(tmp_path / "near.txt")]
+    results = [relocalizer.relocalize(f, region=r) for f, r in zip(frames, regions)]
+    assert python_trajectory(tmp_path / "python.txt", frames, results) == (tmp_path / "cli.txt").read_bytes()
+    found = [(r, region) for r, region in zip(results, regions) if r.status == E.RelocalizationStatus.success]
+    assert len(found) > 90
+    assert all(region.admits(r.pose) for r, region in found if region is not None)
+    with pytest.raises(ValueError, match="PoseRegion"):
+        E.PoseRegion(truth[0].pose, radius_m=0.0)
+
+
 def test_relocalize_frames_on_threads_equals_one_by_one(fr2):
     camera, map_, frames = fr2
     relocalizer = E.ObjectRelocalizer(map_, camera)

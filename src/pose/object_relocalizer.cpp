@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -59,21 +60,39 @@ std::vector<PointMatch> pointMatches(const std::vector<Keypoint>& keypoints, con
 
 /// Why the input cannot be relocalized at all, or empty.
 std::string invalidInput(const Intrinsics& K, const std::optional<GravityPrior>& gravity,
-                         const RelocalizerOptions& options) {
+                         const std::optional<PoseRegion>& region, const RelocalizerOptions& options) {
   if (!K.isValid()) return "invalid intrinsics";
   if (gravity && !gravity->isValid())
     return "invalid gravity prior (zero or non-finite direction, or sigma not positive)";
+  if (region && !region->isValid())
+    return "invalid pose region (non-finite pose, radius not positive, or angle outside (0, 180] degrees)";
   const std::string bad_option = options.validate();
   return bad_option.empty() ? "" : "invalid options: " + bad_option;
 }
 
 /// What every hypothesis of a frame must pass, prepared once: a tilt within max(gate_deg, 5
-/// sigma) of the gravity prior, and the camera envelope.
-PoseGate frameGate(const std::optional<GravityPrior>& gravity, const RelocalizerOptions& options) {
+/// sigma) of the gravity prior, the camera envelope and the pose region.
+PoseGate frameGate(const std::optional<GravityPrior>& gravity, const std::optional<PoseRegion>& region,
+                   const RelocalizerOptions& options) {
   PoseGate gate;
   if (gravity) gate.gravity = gravity->bound(std::max(options.gravity.gate_deg, 5.0 * gravity->sigma_deg));
   if (options.envelope) gate.envelope = options.envelope->prepared();
+  if (region) gate.region = region->prepared();
   return gate;
+}
+
+/// The host's last tracked pose is a hypothesis too: when the camera has barely moved since, it
+/// refines to the answer even where no triplet's pose does.
+void offerRegionPose(const HypothesisEstimator& estimator, const Pose& pose, HypothesisPool* pool,
+                     SearchOutcome* search) {
+  PoseHypothesis h{pose, {}};
+  int inliers = 0;
+  const double cost = estimator.score(h, &inliers);  // infinite when it could not enter the pool
+  if (!std::isfinite(cost)) return;
+  pool->offer(h.pose, cost);
+  ++search->hypotheses;
+  search->found = true;
+  search->best = pool->best().pose;
 }
 
 /// The observations in the canonical order (canonicalOrder) and that order: `order[k]` is the
@@ -134,7 +153,7 @@ RelocalizationResult ObjectRelocalizer::scorePoseInOrder(const std::vector<Obser
                                                          const Pose& pose) const {
   RelocalizationResult result;
   result.pose = pose;
-  const std::string invalid = invalidInput(K_, std::nullopt, options_);
+  const std::string invalid = invalidInput(K_, std::nullopt, std::nullopt, options_);
   if (!invalid.empty() || !pose.isValid()) {
     result.status = RelocalizationStatus::InvalidInput;
     result.reason = invalid.empty() ? "invalid pose" : invalid;
@@ -155,7 +174,7 @@ RelocalizationResult ObjectRelocalizer::scorePoseInOrder(const std::vector<Obser
 
 RelocalizationResult ObjectRelocalizer::refineFromInOrder(const std::vector<Observation>& observations,
                                                           const Pose& start) const {
-  if (!invalidInput(K_, std::nullopt, options_).empty() || !start.isValid())
+  if (!invalidInput(K_, std::nullopt, std::nullopt, options_).empty() || !start.isValid())
     return scorePoseInOrder(observations, start);  // says why
   std::vector<std::pair<int, std::string>> skipped;
   const Candidates candidates =
@@ -195,10 +214,17 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
 RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations,
                                                    const std::vector<Keypoint>& keypoints,
                                                    const std::optional<GravityPrior>& gravity) const {
+  return relocalize(observations, keypoints, gravity, std::nullopt);
+}
+
+RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation>& observations,
+                                                   const std::vector<Keypoint>& keypoints,
+                                                   const std::optional<GravityPrior>& gravity,
+                                                   const std::optional<PoseRegion>& region) const {
   const auto start = std::chrono::steady_clock::now();  // the frame's clock: its time budget and time_ms
   const CanonicalFrame frame = inCanonicalOrder(observations);
   RelocalizationResult result =
-      inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity, start), frame.order);
+      inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity, region, start), frame.order);
   result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -206,6 +232,7 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
 RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Observation>& observations,
                                                           const std::vector<Keypoint>& keypoints,
                                                           const std::optional<GravityPrior>& gravity,
+                                                          const std::optional<PoseRegion>& region,
                                                           std::chrono::steady_clock::time_point start) const {
   RelocalizationResult result;
   const auto finish = [&](RelocalizationStatus status, std::string reason) {
@@ -213,7 +240,7 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
     result.reason = std::move(reason);
     return result;
   };
-  const std::string invalid = invalidInput(K_, gravity, options_);
+  const std::string invalid = invalidInput(K_, gravity, region, options_);
   if (!invalid.empty()) return finish(RelocalizationStatus::InvalidInput, invalid);
 
   // 1. Candidates: three usable observations for P3P, two for the two-object solver, one with gravity.
@@ -241,7 +268,7 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
   // 2. Hypotheses into the pool: triplets, then pairs when the frame has few observations or
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
-  const PoseGate gate = frameGate(gravity, options_);
+  const PoseGate gate = frameGate(gravity, region, options_);
   HypothesisPool pool(options_.refinement.top_k);
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;
@@ -262,6 +289,7 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
   }
   if (few && (usable <= options_.few_objects.max_observations || search.best_inliers < 3))
     searchFewObjects(estimator, candidates, options_, gravity, budget, &pool, &search);
+  if (region && gate.admits(region->pose)) offerRegionPose(estimator, region->pose, &pool, &search);
   result.hypotheses = search.hypotheses;
   result.few_object_hypotheses = search.few_object_hypotheses;
   result.iterations = search.iterations;

@@ -451,6 +451,16 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --min-margin -0.1"},
       {"margin with every pose", reloc + "--map " + d + "/map.json --detections " + d +
                                      "/keyframes.detections.json --min-margin 0.2 --accept-all"},
+      {"near radius without poses",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --near-radius 0.5"},
+      {"near radius of zero", reloc + "--map " + d + "/map.json --detections " + d +
+                                  "/keyframes.detections.json --near " + d + "/keyframes.groundtruth.txt --near-radius 0"},
+      {"NaN near radius", reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --near " +
+                              d + "/keyframes.groundtruth.txt --near-radius nan"},
+      {"NaN near angle", reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --near " +
+                             d + "/keyframes.groundtruth.txt --near-angle nan"},
+      {"near poses that are not a trajectory", reloc + "--map " + d + "/map.json --detections " + d +
+                                                   "/keyframes.detections.json --near " + dir.path("truncated.json")},
       {"gravity sigma without directions",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --gravity-sigma 5"},
       {"overlays folder that is a file", reloc + "--map " + d + "/map.json --detections " + d +

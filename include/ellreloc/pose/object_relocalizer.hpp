@@ -17,7 +17,8 @@
 ///   result       the lowest-cost pose, its matches and statistics; LowEvidence instead of
 ///                Success when the matches support it too weakly (acceptance)
 /// A gravity prior drops every hypothesis whose tilt disagrees with it and lets a single
-/// observation give poses.
+/// observation give poses; a pose region (the host's last tracked pose) drops every hypothesis
+/// outside it.
 
 #include <chrono>
 #include <limits>
@@ -32,6 +33,7 @@
 #include "ellreloc/core/observation.hpp"
 #include "ellreloc/core/pose.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
+#include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
 
 namespace ellreloc {
@@ -41,7 +43,7 @@ enum class RelocalizationStatus {
   NotEnoughObservations,   ///< too few usable observations with a candidate object for the solvers, or to
                            ///< reach acceptance.min_evidence (see RelocalizerOptions)
   NoConsistentHypothesis,  ///< no pose explains at least scoring.min_inliers observations
-  InvalidInput,            ///< invalid intrinsics, gravity prior or options
+  InvalidInput,            ///< invalid intrinsics, gravity prior, pose region or options
   /// A pose was found but the observations support it too weakly (RelocalizationResult::evidence
   /// below acceptance.min_evidence, or its margin below acceptance.min_margin): frames of random
   /// boxes get such poses. `pose` and `inliers` hold it, for a host that can check it otherwise
@@ -118,6 +120,14 @@ class ObjectRelocalizer {
   /// non-finite) is an InvalidInput status.
   RelocalizationResult relocalize(const std::vector<Observation>& observations, const std::vector<Keypoint>& keypoints,
                                   const std::optional<GravityPrior>& gravity) const;
+  /// The same, with the camera known to lie in `region` (PoseRegion: within a distance and an
+  /// angle of the last pose the host tracked): hypotheses outside it are never generated, so
+  /// look-alike objects elsewhere in the map give none, and the search is shorter. nullopt: no
+  /// region. An invalid region (non-positive radius, angle outside (0, 180]) is an InvalidInput
+  /// status.
+  RelocalizationResult relocalize(const std::vector<Observation>& observations, const std::vector<Keypoint>& keypoints,
+                                  const std::optional<GravityPrior>& gravity,
+                                  const std::optional<PoseRegion>& region) const;
 
   /// Scores a pose from elsewhere (tracking, odometry, another relocalizer) the way
   /// relocalize() scores its hypotheses: one-to-one matches, their overlaps and the truncated
@@ -153,6 +163,7 @@ class ObjectRelocalizer {
   RelocalizationResult relocalizeInOrder(const std::vector<Observation>& observations,
                                          const std::vector<Keypoint>& keypoints,
                                          const std::optional<GravityPrior>& gravity,
+                                         const std::optional<PoseRegion>& region,
                                          std::chrono::steady_clock::time_point start) const;
   RelocalizationResult scorePoseInOrder(const std::vector<Observation>& observations, const Pose& pose) const;
   RelocalizationResult refineFromInOrder(const std::vector<Observation>& observations, const Pose& start) const;

@@ -10,6 +10,7 @@
 #include "candidates.hpp"
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
+#include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
 #include "hypothesis_pool.hpp"
 #include "pose_scorer.hpp"
@@ -17,12 +18,14 @@
 namespace ellreloc::pipeline {
 
 /// Drops poses that tilt the camera more than max(gate_deg, 5 sigma) away from a gravity prior,
-/// and poses outside the camera envelope.
+/// and poses outside the camera envelope or the frame's pose region.
 struct PoseGate {
   std::optional<GravityPrior::Bound> gravity;        // none: any tilt
   std::optional<CameraEnvelope::Prepared> envelope;  // none: anywhere
+  std::optional<PoseRegion::Prepared> region;        // none: anywhere
   bool admits(const Pose& pose) const {
-    return (!gravity || gravity->admits(pose)) && (!envelope || envelope->admits(pose));
+    return (!gravity || gravity->admits(pose)) && (!envelope || envelope->admits(pose)) &&
+           (!region || region->admits(pose));
   }
 };
 
