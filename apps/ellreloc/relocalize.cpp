@@ -26,6 +26,58 @@
 
 namespace ellreloc::cli {
 
+namespace {
+
+/// The options of what a host knows beyond the frame: gravity, the map's up and the camera's
+/// envelope, and where the camera was last tracked.
+void addPriorOptions(CLI::App* r, RelocalizeArgs& a) {
+  auto* camera_up = r->add_option("--camera-up", a.camera_up,
+                                  "gravity prior: the up direction in the camera frame (x right, y down, z forward), "
+                                  "for a camera at a fixed tilt, e.g. 0,-1,0 for a level camera")
+                        ->expected(3)
+                        ->delimiter(',');
+  auto* map_up =
+      r->add_option(
+           "--map-up", a.map_up,
+           "the up direction in the map frame, e.g. 0,0,1: with --camera-up a gravity prior; the up of --envelope "
+           "and of --max-tilt")
+          ->expected(3)
+          ->delimiter(',');
+  camera_up->needs(map_up);
+  auto* max_tilt =
+      r->add_option("--max-tilt", a.max_tilt_deg,
+                    "with --map-up and no mapping poses: the camera's image-up stays within this many degrees of the "
+                    "map's up, at any height (90: never upside down); replaces the map's camera_envelope")
+          ->check(CLI::Range(0.0, 180.0))
+          ->needs(map_up)
+          ->excludes("--envelope")
+          ->excludes("--no-map-envelope");
+  r->add_option("--max-roll", a.max_roll_deg,
+                "with --max-tilt: the camera's image rows stay within this many degrees of level (90: any roll; "
+                "give an up near the vertical: about a tilted up even a level camera rolls as it turns)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 90.0))
+      ->needs(max_tilt);
+  r->add_option("--gravity-sigma", a.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
+      ->capture_default_str()
+      ->needs(camera_up);
+  auto* near = r->add_option("--near", a.near,
+                             "TUM poses (camera->world) where the camera was last tracked: each frame is searched "
+                             "only near the latest one at or before its timestamp (--near-radius, --near-angle); "
+                             "frames before the first are searched everywhere")
+                   ->check(CLI::ExistingFile);
+  r->add_option("--near-radius", a.near_radius_m, "with --near: how far the camera can have moved, in metres")
+      ->capture_default_str()
+      ->needs(near);
+  r->add_option("--near-angle", a.near_angle_deg,
+                "with --near: how far the camera can have turned, in degrees (180: any way)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 180.0))
+      ->needs(near);
+}
+
+}  // namespace
+
 CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
   CLI::App* r = app.add_subcommand("relocalize", "recover the camera pose of each frame from its detections");
   r->add_option("--camera", a.camera, "camera intrinsics: ORB-SLAM YAML or JSON")->required()->check(CLI::ExistingFile);
@@ -80,49 +132,7 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
   r->add_flag("--accept-all", a.accept_all,
               "report every pose found, however weakly supported (as the oa-slam method does)")
       ->excludes(min_margin);
-  auto* camera_up = r->add_option("--camera-up", a.camera_up,
-                                  "gravity prior: the up direction in the camera frame (x right, y down, z forward), "
-                                  "for a camera at a fixed tilt, e.g. 0,-1,0 for a level camera")
-                        ->expected(3)
-                        ->delimiter(',');
-  auto* map_up =
-      r->add_option(
-           "--map-up", a.map_up,
-           "the up direction in the map frame, e.g. 0,0,1: with --camera-up a gravity prior; the up of --envelope "
-           "and of --max-tilt")
-          ->expected(3)
-          ->delimiter(',');
-  camera_up->needs(map_up);
-  auto* max_tilt =
-      r->add_option("--max-tilt", a.max_tilt_deg,
-                    "with --map-up and no mapping poses: the camera's image-up stays within this many degrees of the "
-                    "map's up, at any height (90: never upside down); replaces the map's camera_envelope")
-          ->check(CLI::Range(0.0, 180.0))
-          ->needs(map_up)
-          ->excludes("--envelope")
-          ->excludes(no_map_envelope);
-  r->add_option("--max-roll", a.max_roll_deg,
-                "with --max-tilt: the camera's image rows stay within this many degrees of level (90: any roll; "
-                "give an up near the vertical: about a tilted up even a level camera rolls as it turns)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 90.0))
-      ->needs(max_tilt);
-  r->add_option("--gravity-sigma", a.gravity_sigma_deg, "accuracy of the gravity prior in degrees")
-      ->capture_default_str()
-      ->needs(camera_up);
-  auto* near = r->add_option("--near", a.near,
-                             "TUM poses (camera->world) where the camera was last tracked: each frame is searched "
-                             "only near the latest one at or before its timestamp (--near-radius, --near-angle); "
-                             "frames before the first are searched everywhere")
-                   ->check(CLI::ExistingFile);
-  r->add_option("--near-radius", a.near_radius_m, "with --near: how far the camera can have moved, in metres")
-      ->capture_default_str()
-      ->needs(near);
-  r->add_option("--near-angle", a.near_angle_deg,
-                "with --near: how far the camera can have turned, in degrees (180: any way)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 180.0))
-      ->needs(near);
+  addPriorOptions(r, a);
   r->footer(
       "Example: ellreloc relocalize --camera camera.yaml --map map.json --detections keyframes.detections.json "
       "--method ours --out poses.txt --report report.json --threads 2");

@@ -142,13 +142,26 @@ std::vector<ProjectableEllipsoid> prepare(const std::vector<EllipseMatch>& match
   return out;
 }
 
+/// Where the poses of a sweep must lie: a camera envelope's heights, tilts and rolls and a pose
+/// region's distance and angle, each when given.
+struct SweepBounds {
+  std::optional<CameraEnvelope::Prepared> envelope;
+  std::optional<PoseRegion::Prepared> region;
+  bool admitsRotation(const Eigen::Matrix3d& R_cw) const {
+    return (!envelope || envelope->admitsRotation(R_cw)) && (!region || region->admitsRotation(R_cw));
+  }
+  bool admits(const Pose& pose) const {
+    return (!envelope || envelope->admits(pose)) && (!region || region->admits(pose));
+  }
+};
+
 /// Sweeps poseAt(angle) (a ScoredPose with the sweep cost, or nullopt) over a full turn,
 /// refines the best local minima of the cost and returns them, best first; with `bounds`, only
 /// those the refinement leaves within them.
 template <typename PoseAt>
 std::vector<ScoredPose> sweepAndRefine(const Intrinsics& K, const std::vector<EllipseMatch>& matches,
                                        const std::optional<GravityPrior>& gravity, const FewObjectOptions& opt,
-                                       const std::optional<CameraEnvelope::Prepared>& bounds, PoseAt poseAt) {
+                                       const SweepBounds& bounds, PoseAt poseAt) {
   const int steps = std::max(4, opt.angle_steps);
   std::vector<double> cost(static_cast<size_t>(steps), std::numeric_limits<double>::infinity());
   std::vector<Pose> pose(static_cast<size_t>(steps));
@@ -172,7 +185,7 @@ std::vector<ScoredPose> sweepAndRefine(const Intrinsics& K, const std::vector<El
       return (p.pose.center() - r.pose.center()).norm() < 0.01 &&
              rotationErrorDeg(p.pose.rotation(), r.pose.rotation()) < 0.5;
     });
-    if (!duplicate && r.pose.isValid() && (!bounds || bounds->admits(r.pose)))
+    if (!duplicate && r.pose.isValid() && bounds.admits(r.pose))
       out.push_back({r.pose, r.fell_back ? cost[k] : r.final_cost});
   }
   std::sort(out.begin(), out.end(), [](const ScoredPose& x, const ScoredPose& y) { return x.cost < y.cost; });
@@ -187,11 +200,14 @@ bool usable(const Intrinsics& K, const EllipseMatch& m) {
 
 std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
                                             const std::optional<GravityPrior>& gravity, const FewObjectOptions& options,
-                                            const std::optional<CameraEnvelope>& envelope) {
-  if (!usable(K, a) || !usable(K, b) || (gravity && !gravity->isValid()) || (envelope && !envelope->isValid()))
+                                            const std::optional<CameraEnvelope>& envelope,
+                                            const std::optional<PoseRegion>& region) {
+  if (!usable(K, a) || !usable(K, b) || (gravity && !gravity->isValid()) || (envelope && !envelope->isValid()) ||
+      (region && !region->isValid()))
     return {};
-  std::optional<CameraEnvelope::Prepared> bounds;
-  if (envelope) bounds = envelope->prepared();
+  SweepBounds bounds;
+  if (envelope) bounds.envelope = envelope->prepared();
+  if (region) bounds.region = region->prepared();
   const Eigen::Vector3d world_axis = b.ellipsoid.center() - a.ellipsoid.center();
   if (!(world_axis.norm() > 1e-9)) return {};
   // The segment between the centres lies, in the camera, in the plane of the two bearings,
@@ -243,9 +259,10 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
     size_t best_index = 0;
     for (const size_t i : order) {
       if (best && (tilt_cost[i] > best->cost || (tilt_cost[i] == best->cost && i > best_index))) continue;
-      // Rotations outside the envelope's tilts and rolls are not placed: their minima would take
-      // the places of those within, for poses that mostly refine to outside it.
-      if (bounds && !bounds->admitsRotation(rotations[i])) continue;
+      // Rotations outside the envelope's tilts and rolls, or the region's angle, are not placed:
+      // their minima would take the places of those within, for poses that mostly refine to
+      // outside it.
+      if (!bounds.admitsRotation(rotations[i])) continue;
       const std::optional<Pose> pose = placeAll(K, rotations[i], matches, prepared, &shapes);
       if (!pose) continue;
       const double cost = sweepCost(K, *pose, matches, prepared, shapes, gravity, options.refiner);
@@ -266,7 +283,7 @@ std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMat
   const std::vector<EllipseMatch> matches{a};
   const std::vector<ProjectableEllipsoid> prepared = prepare(matches);
   std::vector<Eigen::Matrix3d> shapes;
-  return sweepAndRefine(K, matches, gravity, options, std::nullopt, [&](double yaw) -> std::optional<ScoredPose> {
+  return sweepAndRefine(K, matches, gravity, options, SweepBounds{}, [&](double yaw) -> std::optional<ScoredPose> {
     const std::optional<Pose> pose =
         placeAll(K, align * Eigen::AngleAxisd(yaw, up).toRotationMatrix(), matches, prepared, &shapes);
     if (!pose) return std::nullopt;

@@ -81,6 +81,28 @@ PoseGate frameGate(const std::optional<GravityPrior>& gravity, const std::option
   return gate;
 }
 
+/// Stage 2's triplet search, its samples split over the threads of `scorers` (one estimator on
+/// each).
+struct TripletSearch {
+  const std::vector<Observation>& observations;
+  const ObjectMap& map;
+  const Intrinsics& K;
+  const RelocalizerOptions& options;
+  const PoseGate& gate;
+  const FrameBudget& budget;
+  void run(const Candidates& candidates, const std::vector<PoseScorer*>& scorers, HypothesisPool* pool,
+           SearchOutcome* search) const {
+    std::vector<HypothesisEstimator> estimators;
+    estimators.reserve(scorers.size());
+    std::vector<const HypothesisEstimator*> on_threads;
+    for (PoseScorer* s : scorers) {
+      estimators.emplace_back(observations, candidates, map, K, options, gate, *s, pool);
+      on_threads.push_back(&estimators.back());
+    }
+    searchTriplets(on_threads, candidates, options, budget, pool, search);
+  }
+};
+
 /// The host's last tracked pose is a hypothesis too: when the camera has barely moved since, it
 /// refines to the answer even where no triplet's pose does.
 void offerRegionPose(const HypothesisEstimator& estimator, const Pose& pose, HypothesisPool* pool,
@@ -273,22 +295,19 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;
   const FrameBudget budget = frameBudget(options_.search, map_.objects.size(), usable, start);
-  // Each further thread scores with its own scorer (scratch buffers), through its own estimator.
+  // Each further thread scores with its own scorer (scratch buffers).
   std::vector<PoseScorer> thread_scorers(static_cast<size_t>(options_.search.threads) - 1, scorer);
   std::vector<PoseScorer*> scorers = {&scorer};
   for (PoseScorer& s : thread_scorers) scorers.push_back(&s);
   if (usable >= 3) {
-    std::vector<HypothesisEstimator> helpers;
-    helpers.reserve(thread_scorers.size());
-    std::vector<const HypothesisEstimator*> estimators = {&estimator};
-    for (PoseScorer& s : thread_scorers) {
-      helpers.emplace_back(observations, candidates, map_, K_, options_, gate, s, &pool);
-      estimators.push_back(&helpers.back());
-    }
-    searchTriplets(estimators, candidates, options_, budget, &pool, &search);
+    const TripletSearch triplets{observations, map_, K_, options_, gate, budget};
+    if (region)  // only pairs that can give a pose in the region
+      triplets.run(candidatesWithinRegion(candidates, observations, map_, K_, *region), scorers, &pool, &search);
+    else
+      triplets.run(candidates, scorers, &pool, &search);
   }
   if (few && (usable <= options_.few_objects.max_observations || search.best_inliers < 3))
-    searchFewObjects(estimator, candidates, options_, gravity, budget, &pool, &search);
+    searchFewObjects(estimator, candidates, options_, gravity, region, budget, &pool, &search);
   if (region && gate.admits(region->pose)) offerRegionPose(estimator, region->pose, &pool, &search);
   result.hypotheses = search.hypotheses;
   result.few_object_hypotheses = search.few_object_hypotheses;

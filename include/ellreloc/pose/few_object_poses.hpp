@@ -25,6 +25,7 @@
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/camera_envelope.hpp"
+#include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
@@ -45,12 +46,14 @@ struct FewObjectOptions {
 /// plus gravity). With a camera `envelope`, every pose returned lies within it, and the sweep
 /// places only rotations within its tilt and roll bounds, so that those outside are neither
 /// refined nor take the places of the `max_poses` minima of those within. (Heights are checked
-/// after the refinement only: a placement before it can be tens of centimetres off.) An
-/// invalid envelope gives no pose.
+/// after the refinement only: a placement before it can be tens of centimetres off.) A pose
+/// `region` bounds them the same way: rotations beyond its angle are not placed, and every pose
+/// returned lies within it. An invalid envelope or region gives no pose.
 std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
                                             const std::optional<GravityPrior>& gravity = std::nullopt,
                                             const FewObjectOptions& options = {},
-                                            const std::optional<CameraEnvelope>& envelope = std::nullopt);
+                                            const std::optional<CameraEnvelope>& envelope = std::nullopt,
+                                            const std::optional<PoseRegion>& region = std::nullopt);
 
 /// Poses from one ellipse-ellipsoid correspondence and gravity.
 std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMatch& a, const GravityPrior& gravity,

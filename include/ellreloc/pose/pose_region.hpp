@@ -34,8 +34,11 @@ struct PoseRegion {
     double max_squared_distance;
     double min_trace;  // below -1 without a rotation bound
     bool admits(const Pose& p) const {
-      if ((p.center() - centre).squaredNorm() > max_squared_distance) return false;
-      return min_trace < -1.0 || (p.rotation().cwiseProduct(rotation)).sum() >= min_trace;
+      return (p.center() - centre).squaredNorm() <= max_squared_distance && admitsRotation(p.rotation());
+    }
+    /// The angle bound alone, for a world->camera rotation whose translation is not known yet.
+    bool admitsRotation(const Eigen::Matrix3d& R_cw) const {
+      return min_trace < -1.0 || R_cw.cwiseProduct(rotation).sum() >= min_trace;
     }
   };
   Prepared prepared() const {

@@ -130,4 +130,32 @@ Candidates collectCandidates(const std::vector<Observation>& observations, const
   return c;
 }
 
+Candidates candidatesWithinRegion(const Candidates& candidates, const std::vector<Observation>& observations,
+                                  const ObjectMap& map, const Intrinsics& K, const PoseRegion& region) {
+  if (region.max_rotation_deg >= 180.0) return candidates;
+  const double turn = region.max_rotation_deg * M_PI / 180.0;
+  const Eigen::Vector3d centre = region.pose.center();
+  const Eigen::Matrix3d& R = region.pose.rotation();
+  // A pair on the bound is kept: the gate, not this, decides poses there.
+  const auto reachable = [&](const CandidatePair& p) {
+    const Eigen::Vector3d to_object = map.objects[static_cast<size_t>(p.object)].ellipsoid.center() - centre;
+    const double distance = to_object.norm();
+    if (!(distance > region.radius_m)) return true;  // the camera may be next to it: any direction
+    const Eigen::Vector3d seen = R * to_object;
+    const Eigen::Vector3d bearing = K.bearing(observations[static_cast<size_t>(p.observation)].ellipse.center());
+    const double off = std::atan2(seen.cross(bearing).norm(), seen.dot(bearing));
+    return off <= turn + std::asin(region.radius_m / distance) + 1e-9;
+  };
+  Candidates c;
+  c.usable = candidates.usable;
+  c.num_usable = candidates.num_usable;
+  c.of_observation.resize(candidates.of_observation.size());
+  for (const CandidatePair& p : candidates.pairs)  // in PROSAC order
+    if (reachable(p)) c.pairs.push_back(p);
+  for (size_t i = 0; i < candidates.of_observation.size(); ++i)
+    for (const int j : candidates.of_observation[i])
+      if (reachable({static_cast<int>(i), j, 0.0})) c.of_observation[i].push_back(j);
+  return c;
+}
+
 }  // namespace ellreloc::pipeline

@@ -5,8 +5,10 @@
 #include <utility>
 #include <vector>
 
+#include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/core/observation.hpp"
+#include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
 
 namespace ellreloc::pipeline {
@@ -42,5 +44,17 @@ double usableTriplets(const Candidates& candidates);
 Candidates collectCandidates(const std::vector<Observation>& observations, const ObjectMap& map,
                              const ScoringOptions& options, long max_pairs,
                              std::vector<std::pair<int, std::string>>* skipped);
+
+/// The pairs a triplet search draws from inside a pose region: those whose object can lie on its
+/// observation's bearing (the ray through the ellipse's centre, as P3P takes it) from some camera
+/// in the region. From a camera within the region's radius r of its centre, an object at distance
+/// D > r from that centre lies within asin(r / D) of its direction from there, and a camera
+/// turned by at most the region's angle sees that direction at most that angle off: a pair whose
+/// bearing is farther from where the region's pose sees its object gives only P3P poses outside
+/// the region, which the gate drops before anything else. Such pairs leave `pairs` and
+/// `of_observation`; `usable` and `num_usable` are kept, so that scoring counts every observation
+/// as before. Without an angle bound no pair is removed.
+Candidates candidatesWithinRegion(const Candidates& candidates, const std::vector<Observation>& observations,
+                                  const ObjectMap& map, const Intrinsics& K, const PoseRegion& region);
 
 }  // namespace ellreloc::pipeline

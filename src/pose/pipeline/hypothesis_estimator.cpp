@@ -193,11 +193,11 @@ void HypothesisEstimator::fromSolver(const std::vector<ScoredPose>& poses, const
 }
 
 void HypothesisEstimator::fromTwoPairs(int a, int b, const std::optional<GravityPrior>& gravity,
-                                       std::vector<Model>* out) const {
+                                       const std::optional<PoseRegion>& region, std::vector<Model>* out) const {
   const int own[2] = {a, b};
   fromSolver(posesFromTwoObjects(K_, ellipseMatchOf(pairs_[a], observations_, map_),
                                  ellipseMatchOf(pairs_[b], observations_, map_), gravity, options_.few_objects.solver,
-                                 options_.envelope),
+                                 options_.envelope, region),
              own, 2, out);
 }
 

@@ -88,8 +88,10 @@ class HypothesisEstimator {
   /// depend on its thread count: a scorer on another thread may have read an older admission.
   double refineIfLoose(Model* model, double cost, int* num_inliers, double admission) const;
 
-  /// Poses from two candidate pairs (two-object solver), checked like P3P's; appended to `out`.
-  void fromTwoPairs(int a, int b, const std::optional<GravityPrior>& gravity, std::vector<Model>* out) const;
+  /// Poses from two candidate pairs (two-object solver, its sweep kept to the region's angle),
+  /// checked like P3P's; appended to `out`.
+  void fromTwoPairs(int a, int b, const std::optional<GravityPrior>& gravity, const std::optional<PoseRegion>& region,
+                    std::vector<Model>* out) const;
   /// Poses from one candidate pair and gravity; appended to `out`.
   void fromOnePair(int a, const GravityPrior& gravity, std::vector<Model>* out) const;
 

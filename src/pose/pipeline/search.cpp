@@ -87,7 +87,8 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
 
 void searchFewObjects(const HypothesisEstimator& estimator, const Candidates& candidates,
                       const RelocalizerOptions& options, const std::optional<GravityPrior>& gravity,
-                      const FrameBudget& budget, HypothesisPool* pool, SearchOutcome* outcome) {
+                      const std::optional<PoseRegion>& region, const FrameBudget& budget, HypothesisPool* pool,
+                      SearchOutcome* outcome) {
   const std::vector<CandidatePair>& pairs = candidates.pairs;
   const long max_calls = options.few_objects.max_pair_hypotheses;
   const long max_poses = std::max(0L, budget.max_hypotheses - outcome->hypotheses);
@@ -103,7 +104,7 @@ void searchFewObjects(const HypothesisEstimator& estimator, const Candidates& ca
     for (size_t j = i + 1; j < pairs.size() && more(); ++j) {
       if (pairs[i].observation == pairs[j].observation || pairs[i].object == pairs[j].object) continue;
       ++calls;
-      estimator.fromTwoPairs(static_cast<int>(i), static_cast<int>(j), gravity, &poses);
+      estimator.fromTwoPairs(static_cast<int>(i), static_cast<int>(j), gravity, region, &poses);
     }
   if (gravity && candidates.num_usable == 1)
     for (size_t i = 0; i < pairs.size() && more(); ++i, ++calls)

@@ -49,9 +49,11 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
 
 /// The two-object solver on pairs of candidate pairs, and with gravity and a single usable
 /// observation, the one-object solver: up to few_objects.max_pair_hypotheses solver calls, and
-/// no more hypotheses or time than `budget` leaves after the triplets.
+/// no more hypotheses or time than `budget` leaves after the triplets. The two-object sweep keeps
+/// to the `region`'s angle.
 void searchFewObjects(const HypothesisEstimator& estimator, const Candidates& candidates,
                       const RelocalizerOptions& options, const std::optional<GravityPrior>& gravity,
-                      const FrameBudget& budget, HypothesisPool* pool, SearchOutcome* outcome);
+                      const std::optional<PoseRegion>& region, const FrameBudget& budget, HypothesisPool* pool,
+                      SearchOutcome* outcome);
 
 }  // namespace ellreloc::pipeline
