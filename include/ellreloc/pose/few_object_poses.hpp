@@ -25,8 +25,8 @@
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/camera_envelope.hpp"
-#include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/gravity_prior.hpp"
+#include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
 namespace ellreloc {
