@@ -104,13 +104,14 @@ struct TripletSearch {
 };
 
 /// The host's last tracked pose is a hypothesis too: when the camera has barely moved since, it
-/// refines to the answer even where no triplet's pose does.
+/// refines to the answer even where no triplet's pose does. One that matches nothing has nothing
+/// to refine on and is no answer.
 void offerRegionPose(const HypothesisEstimator& estimator, const Pose& pose, HypothesisPool* pool,
                      SearchOutcome* search) {
   PoseHypothesis h{pose, {}};
   int inliers = 0;
   const double cost = estimator.score(h, &inliers);  // infinite when it could not enter the pool
-  if (!std::isfinite(cost)) return;
+  if (!std::isfinite(cost) || inliers == 0) return;
   pool->offer(h.pose, cost);
   ++search->hypotheses;
   search->found = true;
