@@ -151,9 +151,9 @@ struct ReferenceScore {
 std::vector<RelocalizationResult> relocalizeFrames(
     const ObjectRelocalizer& relocalizer, const std::vector<DetectionFrame>& frames,
     const std::vector<std::vector<Keypoint>>& keypoints, const std::optional<GravityPrior>& gravity,
-    const std::vector<std::optional<PoseRegion>>& regions, const ObserveOptions& observe_options, const std::vector<std::optional<Pose>>& references, int threads,
-    const Console& console, std::vector<std::vector<Observation>>* observations_out,
-    std::vector<ReferenceScore>* reference_scores) {
+    const std::vector<std::optional<PoseRegion>>& regions, const ObserveOptions& observe_options,
+    const std::vector<std::optional<Pose>>& references, int threads, const Console& console,
+    std::vector<std::vector<Observation>>* observations_out, std::vector<ReferenceScore>* reference_scores) {
   // Frames are independent: `threads` workers take the next frame until none is left (the
   // calling thread only shows progress). The first exception of any worker stops the others
   // and is rethrown here, so a worker's failure is reported like the calling thread's.

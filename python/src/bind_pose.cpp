@@ -109,8 +109,12 @@ RelocalizationResult relocalizeOne(const Relocalizer& r, const py::handle& frame
 }
 
 std::vector<RelocalizationResult> relocalizeMany(const Relocalizer& r, const std::vector<DetectionFrame>& frames,
-                                                 int threads) {
+                                                 int threads,
+                                                 const std::optional<std::vector<std::optional<PoseRegion>>>& regions) {
   if (threads < 1) badArgument("threads", "must be at least 1");
+  if (regions && regions->size() != frames.size())
+    badArgument("regions", "expected one PoseRegion or None per frame (" + std::to_string(frames.size()) + "), found " +
+                               std::to_string(regions->size()));
   std::vector<RelocalizationResult> results(frames.size());
   py::gil_scoped_release release;
   std::atomic<size_t> next{0};
@@ -119,7 +123,8 @@ std::vector<RelocalizationResult> relocalizeMany(const Relocalizer& r, const std
   const auto work = [&] {
     try {
       for (size_t i = next++; i < frames.size(); i = next++)
-        results[i] = r.relocalizer.relocalize(r.observations(frames[i]), frames[i].keypoints);
+        results[i] = r.relocalizer.relocalize(r.observations(frames[i]), frames[i].keypoints, std::nullopt,
+                                              regions ? (*regions)[i] : std::nullopt);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(failure_mutex);
       failure = std::current_exception();
@@ -421,7 +426,9 @@ void bindRelocalizer(py::module_& m) {
            "items or an (n, 3) array of (point_index, u, v); `gravity`: a GravityPrior; `region`: a PoseRegion "
            "(poses outside it are never hypotheses). The GIL is released meanwhile.")
       .def("relocalize_frames", &relocalizeMany, py::arg("frames"), py::arg("threads") = 1,
-           "Relocalizes many DetectionFrames in C++ on `threads` threads; the same results as relocalize() on each.")
+           py::arg("regions") = py::none(),
+           "Relocalizes many DetectionFrames in C++ on `threads` threads; the same results as relocalize() on each "
+           "(with `regions`, one PoseRegion or None per frame, as its `region`).")
       .def(
           "observe", [](const Relocalizer& r, const py::handle& frame) { return observationsFrom(r, frame, nullptr); },
           py::arg("frame"), "The observations relocalize() makes of a frame.")

@@ -48,6 +48,11 @@ def test_a_pose_region_gives_the_command_lines_near_poses(fr2, data_dir, cli, tm
                         for s in E.read_trajectory(tmp_path / "near.txt")]
     results = [relocalizer.relocalize(f, region=r) for f, r in zip(frames, regions)]
     assert python_trajectory(tmp_path / "python.txt", frames, results) == (tmp_path / "cli.txt").read_bytes()
+    batch = relocalizer.relocalize_frames(frames, threads=2, regions=regions)
+    assert [b.status for b in batch] == [r.status for r in results]
+    assert all(np.array_equal(b.T_wc, r.T_wc) for b, r in zip(batch, results) if r.pose is not None)
+    with pytest.raises(ValueError, match="regions: expected one PoseRegion or None per frame"):
+        relocalizer.relocalize_frames(frames, regions=regions[:3])
     found = [(r, region) for r, region in zip(results, regions) if r.status == E.RelocalizationStatus.success]
     assert len(found) > 90
     assert all(region.admits(r.pose) for r, region in found if region is not None)

@@ -454,7 +454,8 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
       {"near radius without poses",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --near-radius 0.5"},
       {"near radius of zero", reloc + "--map " + d + "/map.json --detections " + d +
-                                  "/keyframes.detections.json --near " + d + "/keyframes.groundtruth.txt --near-radius 0"},
+                                  "/keyframes.detections.json --near " + d +
+                                  "/keyframes.groundtruth.txt --near-radius 0"},
       {"NaN near radius", reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --near " +
                               d + "/keyframes.groundtruth.txt --near-radius nan"},
       {"NaN near angle", reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --near " +

@@ -48,8 +48,8 @@ TEST(Candidates, WithinARegionEveryPairAPoseInItCouldSeeIsKept) {
   const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   ObjectMap map;
   for (int j = 0; j < 40; ++j)
-    map.objects.push_back({j, 1, "", Ellipsoid({3 * u(rng), 3 * u(rng), u(rng)}, {0.1, 0.1, 0.1},
-                                               Eigen::Matrix3d::Identity())});
+    map.objects.push_back(
+        {j, 1, "", Ellipsoid({3 * u(rng), 3 * u(rng), u(rng)}, {0.1, 0.1, 0.1}, Eigen::Matrix3d::Identity())});
   int kept_total = 0, pairs_total = 0;
   for (int trial = 0; trial < 20; ++trial) {
     PoseRegion region;
@@ -92,8 +92,9 @@ TEST(Candidates, WithinARegionEveryPairAPoseInItCouldSeeIsKept) {
     EXPECT_EQ(in.usable, all.usable);
     for (size_t o = 0; o < observations.size(); ++o) {
       const int j = seen[o];
-      EXPECT_TRUE(std::any_of(in.pairs.begin(), in.pairs.end(),
-                              [&](const pipeline::CandidatePair& p) { return p.observation == int(o) && p.object == j; }))
+      EXPECT_TRUE(
+          std::any_of(in.pairs.begin(), in.pairs.end(),
+                      [&](const pipeline::CandidatePair& p) { return p.observation == int(o) && p.object == j; }))
           << "trial " << trial << ", observation " << o;
       const std::vector<int>& of = in.of_observation[o];
       EXPECT_NE(std::find(of.begin(), of.end(), j), of.end());

@@ -288,9 +288,9 @@ TEST(FewObjectPoses, TwoObjectsKeepToAPoseRegion) {
     ++trials;
     // Where a host last tracked the camera: 20 cm and 10 degrees off the truth.
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
-    const PoseRegion region{Pose::fromCameraToWorld(truth.inverse().rotation() * turn,
-                                                    truth.center() + Eigen::Vector3d(0.0, 0.2, 0.0)),
-                            0.5, 30.0};
+    const PoseRegion region{
+        Pose::fromCameraToWorld(truth.inverse().rotation() * turn, truth.center() + Eigen::Vector3d(0.0, 0.2, 0.0)),
+        0.5, 30.0};
     const auto kept = posesFromTwoObjects(K, m[0], m[1], std::nullopt, {}, std::nullopt, region);
     const auto all = posesFromTwoObjects(K, m[0], m[1]);
     for (const ScoredPose& p : kept) EXPECT_TRUE(region.admits(p.pose)) << "trial " << trial;

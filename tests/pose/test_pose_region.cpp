@@ -21,9 +21,9 @@ TEST(PoseRegion, AdmitsExactlyThePosesWithinItsDistanceAndAngle) {
     const Eigen::Vector3d axis = Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
     const double angle = uniform(rng, 0.0, std::min(179.0, 2.0 * region.max_rotation_deg)) * M_PI / 180.0;
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-    const Eigen::Vector3d shift = Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1))
-                                      .normalized() *
-                                  uniform(rng, 0.0, 2.0 * region.radius_m);
+    const Eigen::Vector3d shift =
+        Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)).normalized() *
+        uniform(rng, 0.0, 2.0 * region.radius_m);
     const Pose p = Pose::fromCameraToWorld(region.pose.inverse().rotation() * turn, region.pose.center() + shift);
     // Independently: the distance between the centres, the angle by rotationErrorDeg's quaternion.
     const double distance = (p.center() - region.pose.center()).norm();
@@ -65,10 +65,13 @@ ObjectMap twinDesks() {
     const Eigen::Vector3d at(3.0 * copy, 0.0, 0.0);
     const int id = 10 * copy;
     map.objects.push_back({id + 0, 62, "tv", Ellipsoid(at + Eigen::Vector3d(0.0, 0.3, 0.25), {0.28, 0.04, 0.18}, I)});
-    map.objects.push_back({id + 1, 66, "keyboard", Ellipsoid(at + Eigen::Vector3d(0.0, 0.0, 0.01), {0.22, 0.08, 0.02}, I)});
-    map.objects.push_back({id + 2, 73, "book", Ellipsoid(at + Eigen::Vector3d(-0.45, 0.1, 0.03), {0.1, 0.14, 0.03}, I)});
+    map.objects.push_back(
+        {id + 1, 66, "keyboard", Ellipsoid(at + Eigen::Vector3d(0.0, 0.0, 0.01), {0.22, 0.08, 0.02}, I)});
+    map.objects.push_back(
+        {id + 2, 73, "book", Ellipsoid(at + Eigen::Vector3d(-0.45, 0.1, 0.03), {0.1, 0.14, 0.03}, I)});
     map.objects.push_back({id + 3, 73, "book", Ellipsoid(at + Eigen::Vector3d(0.45, 0.15, 0.1), {0.03, 0.11, 0.1}, I)});
-    map.objects.push_back({id + 4, 41, "cup", Ellipsoid(at + Eigen::Vector3d(0.35, -0.15, 0.05), {0.04, 0.04, 0.05}, I)});
+    map.objects.push_back(
+        {id + 4, 41, "cup", Ellipsoid(at + Eigen::Vector3d(0.35, -0.15, 0.05), {0.04, 0.04, 0.05}, I)});
   }
   return map;
 }
@@ -100,8 +103,8 @@ TEST(PoseRegion, TheRegionChoosesBetweenLookAlikesAndEveryPoseLiesInIt) {
     // Around where the host last tracked the camera, 30 cm and 10 degrees off the truth.
     PoseRegion region;
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    region.pose = Pose::fromCameraToWorld(truth.inverse().rotation() * turn,
-                                          truth.center() + Eigen::Vector3d(0.3, 0.0, 0.0));
+    region.pose =
+        Pose::fromCameraToWorld(truth.inverse().rotation() * turn, truth.center() + Eigen::Vector3d(0.3, 0.0, 0.0));
     region.radius_m = 1.0;
     region.max_rotation_deg = 30.0;
     const RelocalizationResult here = relocalizer.relocalize(observations, {}, std::nullopt, region);
@@ -117,7 +120,8 @@ TEST(PoseRegion, TheRegionChoosesBetweenLookAlikesAndEveryPoseLiesInIt) {
     const RelocalizationResult twin = relocalizer.relocalize(observations, {}, std::nullopt, there);
     ASSERT_EQ(twin.status, RelocalizationStatus::Success) << twin.reason;
     EXPECT_LT((twin.pose.center() - (truth.center() + twin_offset)).norm(), 0.01);
-    for (const ObjectCorrespondence& m : twin.inliers) EXPECT_EQ(map.objects[m.object].id, 10 + object_of[m.observation]);
+    for (const ObjectCorrespondence& m : twin.inliers)
+      EXPECT_EQ(map.objects[m.object].id, 10 + object_of[m.observation]);
 
     // A region between the desks that holds neither pose: no pose, or one inside it.
     PoseRegion between = region;

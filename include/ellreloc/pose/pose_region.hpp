@@ -42,8 +42,7 @@ struct PoseRegion {
     }
   };
   Prepared prepared() const {
-    const double min_trace =
-        max_rotation_deg >= 180.0 ? -2.0 : 1.0 + 2.0 * std::cos(max_rotation_deg * M_PI / 180.0);
+    const double min_trace = max_rotation_deg >= 180.0 ? -2.0 : 1.0 + 2.0 * std::cos(max_rotation_deg * M_PI / 180.0);
     return {pose.center(), pose.rotation(), radius_m * radius_m, min_trace};
   }
 
