@@ -1,5 +1,6 @@
-// The relocalizer with a small map and observations built from the fuzzer's numbers: a
-// status, never a crash, and a successful pose is a valid rigid transform.
+// The relocalizer with a small map and observations built from the fuzzer's numbers (and maybe
+// a gravity prior and a pose region): a status, never a crash, and a successful pose is a valid
+// rigid transform, within the region when there is one.
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "fuzz_input.hpp"
 
@@ -31,14 +32,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::optional<GravityPrior> gravity;
   if (in.small(2) == 1)
     gravity = GravityPrior{{num(-1, 1), num(-1, 1), num(-1, 1)}, {num(-1, 1), num(-1, 1), num(-1, 1)}, num(0.1, 10)};
+  std::optional<PoseRegion> region;
+  if (in.small(2) == 1)
+    region = PoseRegion{Pose::lookAt({num(-3, 3), num(-3, 3), num(0, 2)}, {num(-1, 1), num(-1, 1), num(0, 1)}),
+                        num(0.05, 3), num(1, 180)};
   RelocalizerOptions options;
   options.search.budget.max_hypotheses = 200;  // keep each run short
   options.few_objects.max_pair_hypotheses = 20;
   options.few_objects.solver.angle_steps = 8;  // coarse sweeps: the paths matter here, not the accuracy
   options.few_objects.solver.axis_step_deg = 60.0;
   const ObjectRelocalizer relocalizer(map, Intrinsics(525, 525, 319.5, 239.5, 640, 480), options);
-  const RelocalizationResult r = relocalizer.relocalize(observations, {}, gravity);
+  const RelocalizationResult r = relocalizer.relocalize(observations, {}, gravity, region);
   FUZZ_CHECK(r.status != RelocalizationStatus::Success || r.pose.isValid());
+  // A pose found in a region lies in it; an invalid region is a status.
+  FUZZ_CHECK(!region || !region->isValid() || r.status != RelocalizationStatus::Success || region->admits(r.pose));
+  FUZZ_CHECK(!region || region->isValid() || r.status == RelocalizationStatus::InvalidInput);
   // The budgets hold: triplets, and up to max_poses poses per pair (or single object).
   FUZZ_CHECK(r.hypotheses - r.few_object_hypotheses <= options.search.budget.max_hypotheses + 4);
   FUZZ_CHECK(r.few_object_hypotheses <= options.few_objects.max_pair_hypotheses * options.few_objects.solver.max_poses);
