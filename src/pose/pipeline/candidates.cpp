@@ -136,25 +136,33 @@ Candidates candidatesWithinRegion(const Candidates& candidates, const std::vecto
   const double turn = region.max_rotation_deg * M_PI / 180.0;
   const Eigen::Vector3d centre = region.pose.center();
   const Eigen::Matrix3d& R = region.pose.rotation();
-  // A pair on the bound is kept: the gate, not this, decides poses there.
-  const auto reachable = [&](const CandidatePair& p) {
-    const Eigen::Vector3d to_object = map.objects[static_cast<size_t>(p.object)].ellipsoid.center() - centre;
-    const double distance = to_object.norm();
-    if (!(distance > region.radius_m)) return true;  // the camera may be next to it: any direction
-    const Eigen::Vector3d seen = R * to_object;
-    const Eigen::Vector3d bearing = K.bearing(observations[static_cast<size_t>(p.observation)].ellipse.center());
-    const double off = std::atan2(seen.cross(bearing).norm(), seen.dot(bearing));
-    return off <= turn + std::asin(region.radius_m / distance) + 1e-9;
-  };
   Candidates c;
   c.usable = candidates.usable;
   c.num_usable = candidates.num_usable;
   c.of_observation.resize(candidates.of_observation.size());
-  for (const CandidatePair& p : candidates.pairs)  // in PROSAC order
-    if (reachable(p)) c.pairs.push_back(p);
-  for (size_t i = 0; i < candidates.of_observation.size(); ++i)
-    for (const int j : candidates.of_observation[i])
-      if (reachable({static_cast<int>(i), j, 0.0})) c.of_observation[i].push_back(j);
+  // Each pair's verdict once, by observation and object: `pairs` holds the same pairs in PROSAC order.
+  std::vector<std::vector<char>> reachable(candidates.of_observation.size());
+  for (size_t i = 0; i < candidates.of_observation.size(); ++i) {
+    if (candidates.of_observation[i].empty()) continue;
+    reachable[i].assign(map.objects.size(), 0);
+    const Eigen::Vector3d bearing = K.bearing(observations[i].ellipse.center());
+    for (const int j : candidates.of_observation[i]) {
+      const Eigen::Vector3d to_object = map.objects[static_cast<size_t>(j)].ellipsoid.center() - centre;
+      const double distance = to_object.norm();
+      // The camera may be next to the object: any direction. A pair on the bound is kept: the
+      // gate, not this, decides poses there.
+      bool keep = !(distance > region.radius_m);
+      if (!keep) {
+        const Eigen::Vector3d seen = R * to_object;
+        const double off = std::atan2(seen.cross(bearing).norm(), seen.dot(bearing));
+        keep = off <= turn + std::asin(region.radius_m / distance) + 1e-9;
+      }
+      if (keep) c.of_observation[i].push_back(j);
+      reachable[i][static_cast<size_t>(j)] = keep;
+    }
+  }
+  for (const CandidatePair& p : candidates.pairs)
+    if (reachable[static_cast<size_t>(p.observation)][static_cast<size_t>(p.object)]) c.pairs.push_back(p);
   return c;
 }
 
