@@ -13,6 +13,7 @@
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/pose/relocalizer_options.hpp"
+#include "ellreloc/pose/track_relocalizer.hpp"
 #include "figure.hpp"
 
 namespace CLI {
@@ -88,6 +89,11 @@ struct RelocalizeArgs {
   std::string near;
   double near_radius_m = PoseRegion().radius_m;
   double near_angle_deg = PoseRegion().max_rotation_deg;
+  /// TUM poses from the host's own odometry (camera->world in its frame, metric): the frames are
+  /// relocalized in timestamp order as one track (TrackRelocalizer); a frame without a pose within
+  /// 20 ms of its timestamp is relocalized alone and starts the track again. Empty: none.
+  std::string track;
+  int track_frames = TrackOptions().max_frames;
 };
 /// `use_points` is set after parsing, from whether --points was given.
 CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a);

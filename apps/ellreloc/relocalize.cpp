@@ -23,6 +23,7 @@
 #include "ellreloc/io/trajectory.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/pose/track_relocalizer.hpp"
 
 namespace ellreloc::cli {
 
@@ -74,6 +75,16 @@ void addPriorOptions(CLI::App* r, RelocalizeArgs& a) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 180.0))
       ->needs(near);
+  auto* track = r->add_option("--track", a.track,
+                              "TUM poses from your own odometry (camera->world in its frame, metric): the frames are "
+                              "relocalized in timestamp order as one track, each with the last --track-frames "
+                              "frames' help; a frame without a pose within 20 ms starts the track again")
+                    ->check(CLI::ExistingFile)
+                    ->excludes(near);
+  r->add_option("--track-frames", a.track_frames, "with --track: the newest frames kept in the track")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000))
+      ->needs(track);
 }
 
 }  // namespace
@@ -146,6 +157,43 @@ struct ReferenceScore {
   RelocalizationResult given, refined;
 };
 
+/// The score of a frame's reference pose, as given and refined.
+ReferenceScore scoreReference(const ObjectRelocalizer& relocalizer, const std::vector<Observation>& observations,
+                              const Pose& reference) {
+  return {relocalizer.scorePose(observations, reference), relocalizer.refineFrom(observations, reference)};
+}
+
+/// --track: the frames in timestamp order as one track (TrackRelocalizer), on this thread; a
+/// frame without an odometry pose is relocalized alone and starts the track again. Fills what
+/// relocalizeFrames does, and `tracks` with each tracked frame's track result.
+std::vector<RelocalizationResult> relocalizeAlongTrack(
+    const ObjectRelocalizer& relocalizer, const std::vector<DetectionFrame>& frames,
+    const std::vector<double>& timestamps, const std::vector<std::optional<Pose>>& odometry,
+    const TrackOptions& track_options, const std::optional<GravityPrior>& gravity,
+    const ObserveOptions& observe_options, const std::vector<std::optional<Pose>>& references,
+    std::vector<std::vector<Observation>>* observations_out, std::vector<ReferenceScore>* reference_scores,
+    std::vector<std::optional<TrackResult>>* tracks) {
+  std::vector<size_t> order(frames.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return timestamps[x] < timestamps[y]; });
+  std::vector<RelocalizationResult> results(frames.size());
+  const Intrinsics& K = relocalizer.intrinsics();
+  TrackRelocalizer track(relocalizer, track_options);
+  for (const size_t i : order) {
+    const std::vector<Observation>& observations = (*observations_out)[i] =
+        observeDetections(frames[i].detections, K.width, K.height, observe_options);
+    if (odometry[i]) {
+      (*tracks)[i] = track.add(observations, *odometry[i], gravity);
+      results[i] = (*tracks)[i]->result;
+    } else {
+      track.reset();
+      results[i] = relocalizer.relocalize(observations, {}, gravity);
+    }
+    if (references[i]) (*reference_scores)[i] = scoreReference(relocalizer, observations, *references[i]);
+  }
+  return results;
+}
+
 /// Observes and relocalizes every frame on `threads` worker threads; `observations` receives
 /// each frame's observations, `reference_scores` the score of each frame's reference pose.
 std::vector<RelocalizationResult> relocalizeFrames(
@@ -169,9 +217,7 @@ std::vector<RelocalizationResult> relocalizeFrames(
         const std::vector<Observation>& observations = (*observations_out)[i] =
             observeDetections(frames[i].detections, K.width, K.height, observe_options);
         results[i] = relocalizer.relocalize(observations, keypoints[i], gravity, regions[i]);
-        if (references[i])
-          (*reference_scores)[i] = {relocalizer.scorePose(observations, *references[i]),
-                                    relocalizer.refineFrom(observations, *references[i])};
+        if (references[i]) (*reference_scores)[i] = scoreReference(relocalizer, observations, *references[i]);
         ++finished;
       }
     } catch (...) {
@@ -296,6 +342,38 @@ std::vector<std::optional<PoseRegion>> nearRegions(const RelocalizeArgs& a, cons
   return regions;
 }
 
+/// Each frame's --track odometry pose: the one within 20 ms of its timestamp (none: the frame is
+/// relocalized alone); `without` counts the frames without one.
+std::vector<std::optional<Pose>> trackPoses(const RelocalizeArgs& a, const std::vector<double>& timestamps,
+                                            size_t* without) {
+  std::vector<std::optional<Pose>> poses(timestamps.size());
+  *without = 0;
+  if (a.track.empty()) return poses;
+  const std::vector<io::StampedPose> odometry = io::readTumTrajectory(a.track);
+  for (size_t i = 0; i < timestamps.size(); ++i) {
+    if (const auto k = io::findNearest(odometry, timestamps[i]))
+      poses[i] = odometry[*k].pose;
+    else
+      ++*without;
+  }
+  return poses;
+}
+
+/// Each frame's keypoints for --points: from the detections file itself, or from a file with the
+/// same frames; none without --points.
+std::vector<std::vector<Keypoint>> frameKeypoints(const RelocalizeArgs& a, const ObjectMap& map,
+                                                  const std::vector<DetectionFrame>& frames) {
+  std::vector<std::vector<Keypoint>> keypoints(frames.size());
+  if (!a.use_points) return keypoints;
+  if (map.points.empty()) throw Error(a.map + ": --points needs a map with `points`");
+  std::map<std::string, std::vector<Keypoint>> by_name;
+  if (!a.points.empty())
+    for (const DetectionFrame& f : io::readDetections(a.points)) by_name[f.file_name] = f.keypoints;
+  for (size_t i = 0; i < frames.size(); ++i)
+    keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
+  return keypoints;
+}
+
 /// One frame's entry of the --report JSON (with its diagnosis against a reference pose).
 nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResult& r, int observed,
                            const ObjectMap& map, const Pose* reference, const ReferenceScore& ref,
@@ -405,7 +483,9 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
                                                           {"--points", a.points},
                                                           {"--reference", a.reference},
                                                           {"--envelope", a.envelope},
-                                                          {"--near", a.near}});
+                                                          {"--near", a.near},
+                                                          {"--track", a.track}});
+  if (!a.track.empty() && a.use_points) throw Error("--track: keypoints are not used along a track; drop --points");
   const Intrinsics K = io::readCamera(a.camera);
   std::vector<std::string> left_out;
   const ObjectMap object_map = io::readMap(a.map, &left_out);
@@ -416,6 +496,8 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const RelocalizerOptions options = relocalizerOptions(a, &policy);
   size_t without_region = 0;
   const std::vector<std::optional<PoseRegion>> regions = nearRegions(a, timestamps, &without_region);
+  size_t without_odometry = 0;
+  const std::vector<std::optional<Pose>> odometry = trackPoses(a, timestamps, &without_odometry);
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "solid" : policy);
   const ObjectRelocalizer relocalizer(object_map, K, options);
@@ -432,16 +514,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     if (!gravity->isValid())
       throw Error("--camera-up/--map-up/--gravity-sigma: directions must be finite and non-zero, sigma positive");
   }
-  // Keypoints per frame: from the detections file itself, or from a file with the same frames.
-  std::vector<std::vector<Keypoint>> keypoints(frames.size());
-  if (a.use_points) {
-    if (object_map.points.empty()) throw Error(a.map + ": --points needs a map with `points`");
-    std::map<std::string, std::vector<Keypoint>> by_name;
-    if (!a.points.empty())
-      for (const DetectionFrame& f : io::readDetections(a.points)) by_name[f.file_name] = f.keypoints;
-    for (size_t i = 0; i < frames.size(); ++i)
-      keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
-  }
+  const std::vector<std::vector<Keypoint>> keypoints = frameKeypoints(a, object_map, frames);
 
   std::vector<std::optional<Pose>> references(frames.size());
   if (!a.reference.empty()) {
@@ -454,9 +527,14 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   if (!a.overlays.empty()) makeOverlayFolder(a.overlays);  // inputs read and checked: fail before the work
   std::vector<std::vector<Observation>> observations(frames.size());
   std::vector<ReferenceScore> reference_scores(frames.size());
+  std::vector<std::optional<TrackResult>> tracks(frames.size());
+  TrackOptions track_options;
+  track_options.max_frames = a.track_frames;
   const std::vector<RelocalizationResult> results =
-      relocalizeFrames(relocalizer, frames, keypoints, gravity, regions, observe_options, references, a.threads,
-                       console, &observations, &reference_scores);
+      a.track.empty() ? relocalizeFrames(relocalizer, frames, keypoints, gravity, regions, observe_options, references,
+                                         a.threads, console, &observations, &reference_scores)
+                      : relocalizeAlongTrack(relocalizer, frames, timestamps, odometry, track_options, gravity,
+                                             observe_options, references, &observations, &reference_scores, &tracks);
   console.endProgress();
   std::map<std::string, int> diagnoses;
 
@@ -469,8 +547,11 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     const Pose* reference = references[i] ? &*references[i] : nullptr;
     const std::string diagnosis = reference ? diagnose(r, reference_scores[i], *reference) : "";
     if (reference) ++diagnoses[diagnosis];
-    const nlohmann::json j = frameReport(frames[i], r, static_cast<int>(observations[i].size()), object_map, reference,
-                                         reference_scores[i], diagnosis);
+    nlohmann::json j = frameReport(frames[i], r, static_cast<int>(observations[i].size()), object_map, reference,
+                                   reference_scores[i], diagnosis);
+    if (const std::optional<TrackResult>& t = tracks[i])
+      j["track"] = {{"frames", t->frames},         {"cost", t->track_cost},       {"evidence", t->track_evidence},
+                    {"matches", t->track_matches}, {"candidates", t->candidates}, {"found_by", t->found_by}};
     report.push_back(j);
     if (r.status == RelocalizationStatus::Success) poses.push_back({timestamps[i], r.pose, frames[i].timestampText()});
   }
@@ -482,6 +563,9 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
                 frames.size(), a.method.c_str(), median(times));
   if (without_region > 0 && !console.quiet)
     std::printf("%zu frame(s) before the first pose of %s: searched everywhere\n", without_region, a.near.c_str());
+  if (!a.track.empty() && !console.quiet)
+    std::printf("%zu frame(s) without a pose of %s within 20 ms: relocalized alone, each starting the track again\n",
+                without_odometry, a.track.c_str());
   if (!a.reference.empty()) {  // a result: printed even when quiet
     std::printf("against %s:", a.reference.c_str());
     for (const auto& [diagnosis, count] : diagnoses) std::printf(" %s %d,", diagnosis.c_str(), count);

@@ -27,6 +27,7 @@
 #include "ellreloc/observe/regular_mask.hpp"
 #include "ellreloc/core/rle.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/pose/track_relocalizer.hpp"
 #include "ellreloc/core/p3p.hpp"
 #include "ellreloc/core/ransac.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"

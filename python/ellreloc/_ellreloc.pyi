@@ -666,6 +666,25 @@ class Summary:
     valid_percent: float
 
 
+class TrackRelocalizer:
+    """Relocalizes each new frame of a track a host follows without the map (its odometry gives each frame's pose): every frame's poses, carried to the newest frame, ranked over the whole track (docs/pose.md, 'Over a track')."""
+    def __init__(self, relocalizer: object, max_frames: int = ..., min_mean_evidence: float = ...) -> None: ...
+    def add(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], odometry_pose: Pose, gravity: Optional[GravityPrior] = ...) -> TrackResult: """Adds a frame (a DetectionFrame, or a list of Detection or Observation) with its camera pose in the odometry's frame (world->camera, metric) and relocalizes it with the track's help; an invalid pose leaves the track unchanged (status invalid_input)."""
+    def reset(self) -> None: """Forgets every frame (the odometry restarted)."""
+    def __len__(self) -> int: ...
+
+
+class TrackResult:
+    """What TrackRelocalizer.add() found for the newest frame."""
+    result: RelocalizationResult
+    track_cost: float
+    track_evidence: float
+    track_matches: int
+    frames: int
+    candidates: int
+    found_by: int
+
+
 class TrackingOptions:
     def __init__(self) -> None: ...
     label_weight: float

@@ -15,6 +15,7 @@
 #include "ellreloc/error.hpp"
 #include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/pose/track_relocalizer.hpp"
 #include "ellreloc/pose/wasserstein_refiner.hpp"
 
 namespace ellreloc::python {
@@ -477,6 +478,61 @@ void bindRelocalizer(py::module_& m) {
       "by the usual heights of their categories; a dict (up, t, objects) when the evidence is clear, else None.");
 }
 
+/// A TrackRelocalizer with the Python relocalizer it reads (kept alive) and observes frames with.
+struct Track {
+  py::object owner;
+  const Relocalizer* relocalizer;
+  std::unique_ptr<TrackRelocalizer> track;
+};
+
+void bindTrack(py::module_& m) {
+  py::class_<TrackResult>(m, "TrackResult", "What TrackRelocalizer.add() found for the newest frame.")
+      .def_readonly("result", &TrackResult::result,
+                    "The newest frame's RelocalizationResult: the track's best pose refined on this frame; its "
+                    "matches, cost and score are this frame's, margin, rival and alternatives compare track costs.")
+      .def_readonly("track_cost", &TrackResult::track_cost,
+                    "The sum over the track's frames of their cost at the pose.")
+      .def_readonly("track_evidence", &TrackResult::track_evidence,
+                    "The sum over the track's frames of their evidence at the pose (the acceptance test reads it).")
+      .def_readonly("track_matches", &TrackResult::track_matches, "Observations explained over the track's frames.")
+      .def_readonly("frames", &TrackResult::frames, "Frames in the track, this one included.")
+      .def_readonly("candidates", &TrackResult::candidates, "Distinct poses ranked.")
+      .def_readonly("found_by", &TrackResult::found_by,
+                    "Whose search found the pose: 0 this frame, 1 the one before, ...; -1 when none did.")
+      .def("__repr__", [](const TrackResult& t) {
+        return std::string("TrackResult(") + py::str(py::cast(t.result.status)).cast<std::string>() + ", " +
+               std::to_string(t.frames) + " frames, found by " + std::to_string(t.found_by) + ")";
+      });
+  py::class_<Track>(m, "TrackRelocalizer",
+                    "Relocalizes each new frame of a track a host follows without the map (its odometry gives each "
+                    "frame's pose): every frame's poses, carried to the newest frame, ranked over the whole track "
+                    "(docs/pose.md, 'Over a track').")
+      .def(py::init([](py::object relocalizer, int max_frames, double min_mean_evidence) {
+             TrackOptions options;
+             options.max_frames = max_frames;
+             options.min_mean_evidence = min_mean_evidence;
+             if (const std::string why = options.validate(); !why.empty()) badArgument("TrackRelocalizer", why);
+             const auto* r = relocalizer.cast<const Relocalizer*>();
+             return Track{relocalizer, r, std::make_unique<TrackRelocalizer>(r->relocalizer, options)};
+           }),
+           py::arg("relocalizer"), py::arg("max_frames") = TrackOptions().max_frames,
+           py::arg("min_mean_evidence") = TrackOptions().min_mean_evidence)
+      .def(
+          "add",
+          [](Track& t, const py::handle& frame, const Pose& odometry_pose, const std::optional<GravityPrior>& gravity) {
+            const std::vector<Observation> obs = observationsFrom(*t.relocalizer, frame, nullptr);
+            py::gil_scoped_release release;
+            return t.track->add(obs, odometry_pose, gravity);
+          },
+          py::arg("frame"), py::arg("odometry_pose"), py::arg("gravity") = py::none(),
+          "Adds a frame (a DetectionFrame, or a list of Detection or Observation) with its camera pose in the "
+          "odometry's frame (world->camera, metric) and relocalizes it with the track's help; an invalid pose "
+          "leaves the track unchanged (status invalid_input).")
+      .def(
+          "reset", [](Track& t) { t.track->reset(); }, "Forgets every frame (the odometry restarted).")
+      .def("__len__", [](const Track& t) { return t.track->size(); });
+}
+
 void bindRefiner(py::module_& m) {
   py::class_<EllipseMatch>(m, "EllipseMatch",
                            "An observed ellipse and the map ellipsoid it shows; sigma is the ellipse's expected "
@@ -537,6 +593,7 @@ void bindPose(py::module_& m) {
   bindOptions(m);
   bindResult(m);
   bindRelocalizer(m);
+  bindTrack(m);
   bindRefiner(m);
 }
 

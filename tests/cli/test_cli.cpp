@@ -462,6 +462,17 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                              d + "/keyframes.groundtruth.txt --near-angle nan"},
       {"near poses that are not a trajectory", reloc + "--map " + d + "/map.json --detections " + d +
                                                    "/keyframes.detections.json --near " + dir.path("truncated.json")},
+      {"track frames without odometry",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --track-frames 5"},
+      {"track frames of zero", reloc + "--map " + d + "/map.json --detections " + d +
+                                   "/keyframes.detections.json --track " + d +
+                                   "/keyframes.groundtruth.txt --track-frames 0"},
+      {"track and near", reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --track " +
+                             d + "/keyframes.groundtruth.txt --near " + d + "/keyframes.groundtruth.txt"},
+      {"track and points", reloc + "--map " + d + "/map.json --detections " + d +
+                               "/keyframes.detections.json --track " + d + "/keyframes.groundtruth.txt --points"},
+      {"odometry that is not a trajectory", reloc + "--map " + d + "/map.json --detections " + d +
+                                                "/keyframes.detections.json --track " + dir.path("truncated.json")},
       {"gravity sigma without directions",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --gravity-sigma 5"},
       {"overlays folder that is a file", reloc + "--map " + d + "/map.json --detections " + d +

@@ -6,8 +6,10 @@
 #include "ellreloc/pose/pose_region.hpp"
 #include "ellreloc/sim/map_observations.hpp"
 #include "fixtures/random_geometry.hpp"
+#include "fixtures/twin_desks.hpp"
 
 using namespace ellreloc;
+using ellreloc::test::twinDesks;
 using ellreloc::test::uniform;
 
 TEST(PoseRegion, AdmitsExactlyThePosesWithinItsDistanceAndAngle) {
@@ -56,26 +58,6 @@ TEST(PoseRegion, ValidityNamesNonFiniteAndOutOfRangeBounds) {
 
 namespace {
 
-/// Two copies of one desk (a monitor, a keyboard, two books, a cup), the second 3 m along x:
-/// a view of either explains its image equally well.
-ObjectMap twinDesks() {
-  ObjectMap map;
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  for (int copy = 0; copy < 2; ++copy) {
-    const Eigen::Vector3d at(3.0 * copy, 0.0, 0.0);
-    const int id = 10 * copy;
-    map.objects.push_back({id + 0, 62, "tv", Ellipsoid(at + Eigen::Vector3d(0.0, 0.3, 0.25), {0.28, 0.04, 0.18}, I)});
-    map.objects.push_back(
-        {id + 1, 66, "keyboard", Ellipsoid(at + Eigen::Vector3d(0.0, 0.0, 0.01), {0.22, 0.08, 0.02}, I)});
-    map.objects.push_back(
-        {id + 2, 73, "book", Ellipsoid(at + Eigen::Vector3d(-0.45, 0.1, 0.03), {0.1, 0.14, 0.03}, I)});
-    map.objects.push_back({id + 3, 73, "book", Ellipsoid(at + Eigen::Vector3d(0.45, 0.15, 0.1), {0.03, 0.11, 0.1}, I)});
-    map.objects.push_back(
-        {id + 4, 41, "cup", Ellipsoid(at + Eigen::Vector3d(0.35, -0.15, 0.05), {0.04, 0.04, 0.05}, I)});
-  }
-  return map;
-}
-
 Pose shifted(const Pose& p, const Eigen::Vector3d& by) {
   return Pose::fromCameraToWorld(p.inverse().rotation(), p.center() + by);
 }
@@ -86,7 +68,7 @@ TEST(PoseRegion, TheRegionChoosesBetweenLookAlikesAndEveryPoseLiesInIt) {
   const Intrinsics K = test::testIntrinsics();
   const ObjectMap map = twinDesks();
   const ObjectRelocalizer relocalizer(map, K);
-  const Eigen::Vector3d twin_offset(3.0, 0.0, 0.0);
+  const Eigen::Vector3d twin_offset(test::kTwinDeskOffset, 0.0, 0.0);
   std::mt19937 rng(11);
   int trials = 0;
   while (trials < 20) {

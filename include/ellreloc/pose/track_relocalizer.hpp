@@ -1,0 +1,106 @@
+#pragma once
+/// \file track_relocalizer.hpp
+/// Relocalization over a short track: the frames a host followed since it lost the map, with
+/// their camera poses from its own odometry (visual-inertial, stereo or RGB-D odometry, wheel
+/// odometry, or the new map a SLAM system starts when it loses the old one). One frame's
+/// objects may fit look-alikes elsewhere in the map (the other desk's monitor and keyboard)
+/// as well as the right ones; a few frames seen from elsewhere along the track rarely all do.
+/// Every frame is relocalized on its own once, as it comes; the poses each search found (its
+/// pose and its alternatives) are carried to the newest frame by the odometry and ranked by the
+/// sum of their costs over all the track's frames; the best is refined on the newest frame.
+
+#include <deque>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "ellreloc/core/observation.hpp"
+#include "ellreloc/core/pose.hpp"
+#include "ellreloc/pose/gravity_prior.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+
+namespace ellreloc {
+
+struct TrackOptions {
+  /// The newest frames kept in the track. A longer track sees more of the room, but carries the
+  /// poses further on the odometry's drift.
+  int max_frames = 10;
+  /// With the relocalizer's acceptance test on, a pose is Success only when the track's frames'
+  /// evidence at it averages at least this per frame, besides their sum reaching
+  /// acceptance.min_evidence: a look-alike pose explains a few of each frame's observations,
+  /// the right one most of them. 1.0 keeps fewer wrong poses than one frame's test does on every
+  /// real set measured, and more right ones (docs/benchmarks.md, "Over a track").
+  double min_mean_evidence = 1.0;
+  /// Why the options are unusable, or empty.
+  std::string validate() const;
+};
+
+struct TrackResult {
+  /// The newest frame's answer. `pose` is the track's best pose refined on this frame (world ->
+  /// camera); `inliers`, `cost`, `mean_overlap` and `evidence` are this frame's at it; `margin`,
+  /// `rival` and `alternatives` compare track costs (the other answers the frames' searches
+  /// found, carried to this frame); `hypotheses` and `iterations` are this frame's own search's.
+  /// Success needs `track_evidence` to reach acceptance.min_evidence and to average
+  /// TrackOptions::min_mean_evidence per frame (and the margin acceptance.min_margin); without
+  /// any pose found, this frame's own status.
+  RelocalizationResult result;
+  double track_cost = 0.0;      ///< the sum over the track's frames of their cost at the pose
+  double track_evidence = 0.0;  ///< the sum over the track's frames of their evidence at the pose
+  int track_matches = 0;        ///< observations explained over the track's frames
+  int frames = 0;               ///< frames in the track, this one included
+  int candidates = 0;           ///< distinct poses ranked
+  int found_by = -1;            ///< whose search found the pose: 0 this frame, 1 the one before, ...
+};
+
+/// Keeps the last frames of a track and relocalizes each new one with their help. Holds a
+/// reference to `relocalizer`, which must outlive it. Not thread-safe (one per track); the
+/// relocalizer itself may serve other threads meanwhile.
+class TrackRelocalizer {
+ public:
+  TrackRelocalizer(const ObjectRelocalizer& relocalizer, TrackOptions options = {});
+  ~TrackRelocalizer();
+  TrackRelocalizer(const TrackRelocalizer&) = delete;
+  TrackRelocalizer& operator=(const TrackRelocalizer&) = delete;
+
+  /// Adds a frame: its observations and its camera pose in the odometry's frame (world ->
+  /// camera, metric: the track's poses are carried with it), the oldest frame dropped beyond
+  /// max_frames; relocalizes it (with `gravity`, as ObjectRelocalizer::relocalize) and ranks
+  /// every pose the track's frames found. An invalid odometry pose or options, or input the
+  /// relocalizer turns down (InvalidInput), leaves the track unchanged.
+  TrackResult add(const std::vector<Observation>& observations, const Pose& odometry_pose,
+                  const std::optional<GravityPrior>& gravity = std::nullopt);
+  /// Forgets every frame: when the host's odometry restarts, or tracking on the map resumes.
+  void reset();
+  /// Frames held.
+  int size() const { return static_cast<int>(frames_.size()); }
+
+ private:
+  struct Frame;  // a frame's observations, odometry pose, scorer and own poses
+  /// A pose a frame's search found, carried to the newest frame.
+  struct Carried {
+    Pose pose;     // world -> the newest frame's camera
+    int found_by;  // 0 the newest frame, 1 the one before, ...
+    double cost;   // over the track
+  };
+  /// The cost of the newest frame's pose `pose` over every frame (each at the pose the odometry
+  /// gives it), and with `with_evidence` their evidence and matches (at the report's precision).
+  struct TrackScore {
+    double cost = 0.0, evidence = 0.0;
+    int matches = 0;
+  };
+  TrackScore score(const Pose& pose, bool with_evidence) const;
+  /// The frame joins the track, with the poses its own search found (`own`).
+  void join(const std::vector<Observation>& observations, const Pose& odometry_pose, const RelocalizationResult& own);
+  /// Every frame's poses, carried to the newest frame, each once (5 cm, 3 degrees), cheapest first.
+  std::vector<Carried> rankedPoses() const;
+  /// Fills the result at the chosen pose: this frame's matches, the track's cost and evidence,
+  /// the other answers and the status.
+  void report(const std::vector<Observation>& observations, const Pose& pose, const std::vector<Carried>& ranked,
+              TrackResult* out) const;
+
+  const ObjectRelocalizer& relocalizer_;
+  TrackOptions options_;
+  std::deque<std::unique_ptr<Frame>> frames_;  // oldest first
+};
+
+}  // namespace ellreloc

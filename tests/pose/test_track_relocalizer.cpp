@@ -1,0 +1,181 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "ellreloc/core/evaluation.hpp"
+#include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/pose/track_relocalizer.hpp"
+#include "ellreloc/sim/map_observations.hpp"
+#include "fixtures/random_geometry.hpp"
+#include "fixtures/twin_desks.hpp"
+
+using namespace ellreloc;
+using ellreloc::test::uniform;
+
+namespace {
+
+constexpr int kPlantId = 50;
+
+/// The twin desks with a plant beside the first desk only: a view that holds the plant can tell
+/// the desks apart, one of a desk alone cannot.
+ObjectMap desksAndAPlant() {
+  ObjectMap map = test::twinDesks();
+  map.objects.push_back(
+      {kPlantId, 58, "potted plant", Ellipsoid({-1.1, 0.2, 0.3}, {0.15, 0.15, 0.3}, Eigen::Matrix3d::Identity())});
+  return map;
+}
+
+/// A view of the first desk from in front of it, 0.8-1.4 m away: its objects only.
+Pose deskView(std::mt19937& rng) {
+  const Eigen::Vector3d eye(uniform(rng, -0.3, 0.4), uniform(rng, -1.4, -0.8), uniform(rng, 0.4, 0.8));
+  return Pose::lookAt(eye, Eigen::Vector3d(uniform(rng, -0.05, 0.1), 0.1, 0.1), Eigen::Vector3d::UnitZ());
+}
+
+/// A view of the plant and the left of the first desk.
+Pose plantView(std::mt19937& rng) {
+  const Eigen::Vector3d eye(uniform(rng, -0.9, -0.5), uniform(rng, -1.6, -1.2), uniform(rng, 0.6, 0.9));
+  return Pose::lookAt(eye, Eigen::Vector3d(-0.6, 0.15, 0.2), Eigen::Vector3d::UnitZ());
+}
+
+/// Exact observations of a view and the ids of their objects.
+std::vector<Observation> observe(const ObjectMap& map, const Pose& pose, std::mt19937& rng, std::vector<int>* ids) {
+  std::vector<int> object_of;
+  std::vector<Observation> observations =
+      sim::observeMap(map, test::testIntrinsics(), pose, sim::MapObservationOptions{}, &rng, &object_of);
+  ids->clear();
+  for (int o : object_of) ids->push_back(map.objects[static_cast<size_t>(o)].id);
+  return observations;
+}
+
+bool holds(const std::vector<int>& ids, int id) { return std::find(ids.begin(), ids.end(), id) != ids.end(); }
+
+/// An odometry frame of its own: the map's world seen through an arbitrary rigid motion, so that
+/// only the relative poses of the track's frames carry over (x_world = odometry_to_world x_odometry).
+Pose odometryOf(const Pose& truth, const Pose& odometry_to_world) { return truth * odometry_to_world; }
+
+Pose arbitraryMotion(std::mt19937& rng) {
+  return Pose(test::randomRotation(rng),
+              Eigen::Vector3d(uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -5, 5)));
+}
+
+}  // namespace
+
+TEST(TrackRelocalizer, AnEarlierViewOfAUniqueObjectTellsTheLookAlikeDesksApart) {
+  const ObjectMap map = desksAndAPlant();
+  const ObjectRelocalizer relocalizer(map, test::testIntrinsics());
+  const Eigen::Vector3d twin_offset(test::kTwinDeskOffset, 0.0, 0.0);
+  std::mt19937 rng(3);
+  int trials = 0;
+  while (trials < 10) {
+    std::vector<int> ids_a, ids_b;
+    const Pose truth_a = plantView(rng), truth_b = deskView(rng);
+    const std::vector<Observation> a = observe(map, truth_a, rng, &ids_a);
+    const std::vector<Observation> b = observe(map, truth_b, rng, &ids_b);
+    if (!holds(ids_a, kPlantId) || a.size() < 4 || b.size() < 4 || holds(ids_b, kPlantId)) continue;
+    for (int id : ids_b) ASSERT_LT(id, 10) << "the desk view must not reach the second desk";
+    ++trials;
+
+    // The desk view alone: the twin pose explains it exactly as well as the truth.
+    const Pose twin = Pose::fromCameraToWorld(truth_b.inverse().rotation(), truth_b.center() + twin_offset);
+    EXPECT_NEAR(relocalizer.scorePose(b, truth_b).cost, relocalizer.scorePose(b, twin).cost, 1e-9);
+
+    const Pose odometry_to_world = arbitraryMotion(rng);
+    TrackRelocalizer track(relocalizer);
+    track.add(a, odometryOf(truth_a, odometry_to_world));
+    const TrackResult r = track.add(b, odometryOf(truth_b, odometry_to_world));
+    ASSERT_EQ(r.result.status, RelocalizationStatus::Success) << r.result.reason;
+    EXPECT_EQ(r.frames, 2);
+    EXPECT_LT(poseError(r.result.pose, truth_b).position_cm, 1.0);
+    EXPECT_LT(poseError(r.result.pose, truth_b).rotation_deg, 0.2);
+    for (const ObjectCorrespondence& m : r.result.inliers) EXPECT_EQ(map.objects[m.object].id, ids_b[m.observation]);
+    // The plant view, carried to the desk view, rules the twin out by what it leaves unexplained.
+    EXPECT_GT(r.result.margin, 0.5);
+  }
+}
+
+TEST(TrackRelocalizer, AFrameWithoutObjectsGetsItsPoseFromTheTrack) {
+  const ObjectMap map = desksAndAPlant();
+  const ObjectRelocalizer relocalizer(map, test::testIntrinsics());
+  std::mt19937 rng(8);
+  std::vector<int> ids;
+  std::vector<Observation> a;
+  Pose truth_a;
+  do {
+    truth_a = plantView(rng);
+    a = observe(map, truth_a, rng, &ids);
+  } while (!holds(ids, kPlantId) || a.size() < 4);
+  // The camera then turned away from every object (a blank wall, a covered lens).
+  const Pose truth_b = Pose::lookAt(truth_a.center() + Eigen::Vector3d(0.1, -0.2, 0.0),
+                                    truth_a.center() + Eigen::Vector3d(0.0, -3.0, 0.0), Eigen::Vector3d::UnitZ());
+  ASSERT_TRUE(observe(map, truth_b, rng, &ids).empty());
+
+  const Pose odometry_to_world = arbitraryMotion(rng);
+  TrackRelocalizer track(relocalizer);
+  track.add(a, odometryOf(truth_a, odometry_to_world));
+  const TrackResult r = track.add({}, odometryOf(truth_b, odometry_to_world));
+  ASSERT_EQ(r.result.status, RelocalizationStatus::Success) << r.result.reason;
+  EXPECT_EQ(r.found_by, 1);
+  EXPECT_TRUE(r.result.inliers.empty());
+  EXPECT_LT(poseError(r.result.pose, truth_b).position_cm, 1.0);
+  EXPECT_LT(poseError(r.result.pose, truth_b).rotation_deg, 0.2);
+}
+
+TEST(TrackRelocalizer, KeepsTheNewestFramesAndTurnsDownBadInput) {
+  const ObjectMap map = desksAndAPlant();
+  const ObjectRelocalizer relocalizer(map, test::testIntrinsics());
+  std::mt19937 rng(4);
+  TrackOptions options;
+  options.max_frames = 2;
+  TrackRelocalizer track(relocalizer, options);
+  std::vector<int> ids;
+  for (int k = 0; k < 3; ++k) {
+    const Pose truth = deskView(rng);
+    const TrackResult r = track.add(observe(map, truth, rng, &ids), truth);
+    EXPECT_EQ(r.frames, std::min(k + 1, 2));
+  }
+  EXPECT_EQ(track.size(), 2);
+
+  const Pose nan_pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(std::nan(""), 0.0, 0.0));
+  const TrackResult bad = track.add({}, nan_pose);
+  EXPECT_EQ(bad.result.status, RelocalizationStatus::InvalidInput);
+  EXPECT_NE(bad.result.reason.find("odometry pose"), std::string::npos) << bad.result.reason;
+  EXPECT_EQ(track.size(), 2);
+  track.reset();
+  EXPECT_EQ(track.size(), 0);
+
+  options.max_frames = 0;
+  TrackRelocalizer unusable(relocalizer, options);
+  const TrackResult r = unusable.add({}, deskView(rng));
+  EXPECT_EQ(r.result.status, RelocalizationStatus::InvalidInput);
+  EXPECT_NE(r.result.reason.find("max_frames"), std::string::npos) << r.result.reason;
+  EXPECT_EQ(unusable.size(), 0);
+}
+
+TEST(TrackRelocalizer, TracksOfRandomBoxesGetNoPose) {
+  // Boxes of the map's categories at random places and sizes, frame after frame, along a walk:
+  // no evidence of the map, so no pose may be reported.
+  const ObjectMap map = desksAndAPlant();
+  const Intrinsics K = test::testIntrinsics();
+  const ObjectRelocalizer relocalizer(map, K);
+  std::mt19937 rng(21);
+  const int categories[] = {62, 66, 73, 41, 58};
+  TrackRelocalizer track(relocalizer);
+  Pose odometry;
+  int reported = 0, frames = 0;
+  for (int k = 0; k < 60; ++k, ++frames) {
+    std::vector<Observation> observations;
+    const int n = std::uniform_int_distribution<int>(3, 7)(rng);
+    for (int i = 0; i < n; ++i) {
+      const double w = uniform(rng, 15, 160), h = uniform(rng, 15, 160);
+      const double x = uniform(rng, 0, K.width - w), y = uniform(rng, 0, K.height - h);
+      observations.push_back(*observationFromBox(categories[std::uniform_int_distribution<int>(0, 4)(rng)], 1.0,
+                                                 Box(x, y, x + w, y + h), K.width, K.height));
+    }
+    odometry = Pose(Eigen::AngleAxisd(uniform(rng, -0.05, 0.05), Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                    Eigen::Vector3d(uniform(rng, -0.05, 0.05), 0.0, uniform(rng, -0.05, 0.05))) *
+               odometry;
+    const TrackResult r = track.add(observations, odometry);
+    reported += r.result.status == RelocalizationStatus::Success;
+  }
+  EXPECT_EQ(reported, 0) << "of " << frames << " frames";
+}
