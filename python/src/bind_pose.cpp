@@ -507,16 +507,18 @@ void bindTrack(py::module_& m) {
                     "Relocalizes each new frame of a track a host follows without the map (its odometry gives each "
                     "frame's pose): every frame's poses, carried to the newest frame, ranked over the whole track "
                     "(docs/pose.md, 'Over a track').")
-      .def(py::init([](py::object relocalizer, int max_frames, double min_mean_evidence) {
+      .def(py::init([](py::object relocalizer, int max_frames, double min_mean_evidence, double min_margin) {
              TrackOptions options;
              options.max_frames = max_frames;
              options.min_mean_evidence = min_mean_evidence;
+             options.min_margin = min_margin;
              if (const std::string why = options.validate(); !why.empty()) badArgument("TrackRelocalizer", why);
              const auto* r = relocalizer.cast<const Relocalizer*>();
              return Track{relocalizer, r, std::make_unique<TrackRelocalizer>(r->relocalizer, options)};
            }),
            py::arg("relocalizer"), py::arg("max_frames") = TrackOptions().max_frames,
-           py::arg("min_mean_evidence") = TrackOptions().min_mean_evidence)
+           py::arg("min_mean_evidence") = TrackOptions().min_mean_evidence,
+           py::arg("min_margin") = TrackOptions().min_margin)
       .def(
           "add",
           [](Track& t, const py::handle& frame, const Pose& odometry_pose, const std::optional<GravityPrior>& gravity) {

@@ -18,6 +18,7 @@ using namespace pipeline;
 std::string TrackOptions::validate() const {
   if (max_frames < 1 || max_frames > 1000) return "max_frames is not in [1, 1000]";
   if (!std::isfinite(min_mean_evidence)) return "min_mean_evidence is not finite";
+  if (!(min_margin >= 0.0)) return "min_margin is negative or not a number";
   return "";
 }
 
@@ -194,10 +195,10 @@ void TrackRelocalizer::report(const std::vector<Observation>& observations, cons
     result.status = RelocalizationStatus::LowEvidence;
     std::snprintf(reason, sizeof reason, "track evidence %.2f over %d frame(s): below %.2f per frame", track.evidence,
                   out->frames, options_.min_mean_evidence);
-  } else if (acceptance.enabled && result.margin < acceptance.min_margin) {
+  } else if (acceptance.enabled && result.margin < options_.min_margin) {
     result.status = RelocalizationStatus::LowEvidence;
     std::snprintf(reason, sizeof reason, "track margin %.2f below %.2f: another pose explains the track almost as well",
-                  result.margin, acceptance.min_margin);
+                  result.margin, options_.min_margin);
   } else {
     result.status = RelocalizationStatus::Success;
   }

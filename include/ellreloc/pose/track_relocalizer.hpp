@@ -25,12 +25,15 @@ struct TrackOptions {
   /// The newest frames kept in the track. A longer track sees more of the room, but carries the
   /// poses further on the odometry's drift.
   int max_frames = 10;
-  /// With the relocalizer's acceptance test on, a pose is Success only when the track's frames'
-  /// evidence at it averages at least this per frame, besides their sum reaching
-  /// acceptance.min_evidence: a look-alike pose explains a few of each frame's observations,
-  /// the right one most of them. 1.0 keeps fewer wrong poses than one frame's test does on every
-  /// real set measured, and more right ones (docs/benchmarks.md, "Over a track").
-  double min_mean_evidence = 1.0;
+  /// With the relocalizer's acceptance test on (acceptance.enabled), a pose is Success only when
+  /// the track's frames' evidence at it sums to acceptance.min_evidence and averages at least
+  /// `min_mean_evidence` per frame (a look-alike pose explains a few of each frame's
+  /// observations, the right one most of them), and when the best other pose the track's frames
+  /// found (30 cm or 30 degrees away) costs at least `min_margin` more over the track. Chosen on
+  /// fr2_desk and nine fr3 splits, tracks of 3-20 frames: fewer wrong poses than each frame alone
+  /// on every one, and more right ones (docs/benchmarks.md, "Over a track").
+  double min_mean_evidence = 1.5;
+  double min_margin = 0.5;
   /// Why the options are unusable, or empty.
   std::string validate() const;
 };
@@ -40,9 +43,8 @@ struct TrackResult {
   /// camera); `inliers`, `cost`, `mean_overlap` and `evidence` are this frame's at it; `margin`,
   /// `rival` and `alternatives` compare track costs (the other answers the frames' searches
   /// found, carried to this frame); `hypotheses` and `iterations` are this frame's own search's.
-  /// Success needs `track_evidence` to reach acceptance.min_evidence and to average
-  /// TrackOptions::min_mean_evidence per frame (and the margin acceptance.min_margin); without
-  /// any pose found, this frame's own status.
+  /// Success needs the track's evidence and margin to pass TrackOptions' test; without any pose
+  /// found, this frame's own status.
   RelocalizationResult result;
   double track_cost = 0.0;      ///< the sum over the track's frames of their cost at the pose
   double track_evidence = 0.0;  ///< the sum over the track's frames of their evidence at the pose
