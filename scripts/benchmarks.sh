@@ -53,6 +53,7 @@ table detection_orders python3 scripts/detection_orders.py "$build"
 table null_frames python3 scripts/null_frames.py "$build"
 table acceptance_margin python3 scripts/acceptance_margin.py "$build"
 table pose_regions python3 scripts/pose_regions.py "$build"
+table tracks python3 scripts/tracks.py "$build"
 table observe_accuracy "$bin/observe_accuracy"
 table mapping_accuracy "$bin/mapping_accuracy" --seeds "$seeds"
 # Observations, voxel maps and relocalization on the independent renderer's scene and on two
