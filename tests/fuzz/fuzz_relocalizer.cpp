@@ -1,7 +1,9 @@
 // The relocalizer with a small map and observations built from the fuzzer's numbers (and maybe
-// a gravity prior and a pose region): a status, never a crash, and a successful pose is a valid
-// rigid transform, within the region when there is one.
+// a gravity prior and a pose region, or a track of two frames along odometry poses from the
+// numbers): a status, never a crash, and a successful pose is a valid rigid transform, within
+// the region when there is one.
 #include "ellreloc/pose/object_relocalizer.hpp"
+#include "ellreloc/pose/track_relocalizer.hpp"
 #include "fuzz_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -50,5 +52,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // The budgets hold: triplets, and up to max_poses poses per pair (or single object).
   FUZZ_CHECK(r.hypotheses - r.few_object_hypotheses <= options.search.budget.max_hypotheses + 4);
   FUZZ_CHECK(r.few_object_hypotheses <= options.few_objects.max_pair_hypotheses * options.few_objects.solver.max_poses);
+  if (in.small(2) == 1) {  // the frame twice along a track, the odometry poses from the numbers
+    TrackOptions track_options;
+    track_options.max_frames = 1 + in.small(2);
+    TrackRelocalizer track(relocalizer, track_options);
+    for (int k = 0; k < 2; ++k) {
+      const Pose odometry(Eigen::AngleAxisd(num(-4, 4), Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                          Eigen::Vector3d(num(-3, 3), num(-3, 3), num(-3, 3)));
+      const int before = track.size();
+      const TrackResult t = track.add(observations, odometry, gravity);
+      FUZZ_CHECK(t.result.status != RelocalizationStatus::Success || t.result.pose.isValid());
+      FUZZ_CHECK(odometry.isValid() || (t.result.status == RelocalizationStatus::InvalidInput && track.size() == before));
+      FUZZ_CHECK(track.size() <= track_options.max_frames);
+    }
+  }
   return 0;
 }
