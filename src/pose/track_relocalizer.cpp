@@ -46,12 +46,6 @@ double evidenceOf(const std::vector<ObjectCorrespondence>& matches, int usable, 
   return sum - acceptance.unexplained_penalty * std::max(0, usable - static_cast<int>(matches.size()));
 }
 
-struct Carried {
-  Pose pose;     // the newest frame's pose
-  int found_by;  // 0 the newest frame, 1 the one before, ...
-  double cost;   // over the track
-};
-
 }  // namespace
 
 TrackRelocalizer::TrackRelocalizer(const ObjectRelocalizer& relocalizer, TrackOptions options)
