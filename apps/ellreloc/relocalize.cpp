@@ -77,8 +77,9 @@ void addPriorOptions(CLI::App* r, RelocalizeArgs& a) {
       ->needs(near);
   auto* track = r->add_option("--track", a.track,
                               "TUM poses from your own odometry (camera->world in its frame, metric): the frames are "
-                              "relocalized in timestamp order as one track, each with the last --track-frames "
-                              "frames' help; a frame without a pose within 20 ms starts the track again")
+                              "relocalized in timestamp order as one track, each with the help of the frames before "
+                              "it (--track-frames in all); a frame without a pose within 20 ms starts the track "
+                              "again")
                     ->check(CLI::ExistingFile)
                     ->excludes(near);
   r->add_option("--track-frames", a.track_frames, "with --track: the newest frames kept in the track")
