@@ -27,7 +27,16 @@ struct TrackRelocalizer::Frame {
   Candidates candidates;
   std::unique_ptr<PoseScorer> scorer;  // reads `observations` and `candidates`
   Pose odometry;                       // world -> camera in the odometry's frame
-  std::vector<Pose> poses;             // what its own search found: its pose, then its alternatives
+  long serial = 0;                     // frames are numbered as they join
+  /// A pose its own search found (its pose, then its alternatives), with its cost on each frame
+  /// of the track: `costs[j - first]` on frame number j. A frame's pose is a fixed pose of every
+  /// other frame (O_j O_k^-1 P_k), so each cost is computed once, when the later of the two joins.
+  struct Found {
+    Pose pose;
+    std::vector<double> costs;
+  };
+  std::vector<Found> found;
+  long first = 0;  // the number of the oldest frame of the track when this one joined
 };
 
 namespace {
@@ -84,27 +93,44 @@ void TrackRelocalizer::join(const std::vector<Observation>& observations, const 
   frame->scorer = std::make_unique<PoseScorer>(frame->observations, frame->candidates, map, relocalizer_.intrinsics(),
                                                options.scoring);
   frame->odometry = odometry_pose;
+  frame->serial = next_serial_++;
   if (own.status == RelocalizationStatus::Success || own.status == RelocalizationStatus::LowEvidence) {
-    frame->poses.push_back(own.pose);
-    for (const ScoredPose& a : own.alternatives) frame->poses.push_back(a.pose);
+    frame->found.push_back({own.pose, {}});
+    for (const ScoredPose& a : own.alternatives) frame->found.push_back({a.pose, {}});
   }
   frames_.push_back(std::move(frame));
   while (size() > options_.max_frames) frames_.pop_front();
+
+  // The costs that are new: the older frames' poses on this frame, this frame's on every frame.
+  Frame& added = *frames_.back();
+  added.first = frames_.front()->serial;
+  const auto cost = [](const Frame& on, const Frame& by, const Pose& pose) {  // `by`'s pose, on frame `on`
+    return on.scorer->cost(on.odometry * by.odometry.inverse() * pose, kRankingIoUVertices);
+  };
+  for (const std::unique_ptr<Frame>& f : frames_) {
+    if (f.get() == &added) continue;
+    for (Frame::Found& p : f->found) p.costs.push_back(cost(added, *f, p.pose));
+  }
+  for (Frame::Found& p : added.found)
+    for (const std::unique_ptr<Frame>& f : frames_) p.costs.push_back(cost(*f, added, p.pose));
 }
 
 std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses() const {
   const Pose& newest = frames_.back()->odometry;
+  const long oldest = frames_.front()->serial;
   std::vector<Carried> carried;
   for (int k = size() - 1; k >= 0; --k) {  // newest first: of equal costs, the newest frame's pose wins
     const Frame& f = *frames_[static_cast<size_t>(k)];
     const Pose back = (f.odometry * newest.inverse()).inverse();  // the frame's pose -> the newest's
-    for (const Pose& p : f.poses) {
-      const Pose pose = back * p;
-      if (std::none_of(carried.begin(), carried.end(), [&](const Carried& c) { return samePose(c.pose, pose); }))
-        carried.push_back({pose, size() - 1 - k, 0.0});
+    for (const Frame::Found& p : f.found) {
+      const Pose pose = back * p.pose;
+      if (std::any_of(carried.begin(), carried.end(), [&](const Carried& c) { return samePose(c.pose, pose); }))
+        continue;
+      double cost = 0.0;  // over the frames the track holds now
+      for (long j = oldest; j <= frames_.back()->serial; ++j) cost += p.costs[static_cast<size_t>(j - f.first)];
+      carried.push_back({pose, size() - 1 - k, cost});
     }
   }
-  for (Carried& c : carried) c.cost = score(c.pose, false).cost;
   std::stable_sort(carried.begin(), carried.end(), [](const Carried& a, const Carried& b) { return a.cost < b.cost; });
   return carried;
 }

@@ -103,6 +103,7 @@ class TrackRelocalizer {
   const ObjectRelocalizer& relocalizer_;
   TrackOptions options_;
   std::deque<std::unique_ptr<Frame>> frames_;  // oldest first
+  long next_serial_ = 0;
 };
 
 }  // namespace ellreloc
