@@ -77,14 +77,14 @@ void addPriorOptions(CLI::App* r, RelocalizeArgs& a) {
       ->needs(near);
   auto* track = r->add_option("--track", a.track,
                               "TUM poses from your own odometry (camera->world in its frame, metric): the frames are "
-                              "relocalized in timestamp order as one track, each with the help of the frames before "
-                              "it (--track-frames in all); a frame without a pose within 20 ms starts the track "
-                              "again")
+                              "relocalized in timestamp order as one track, on one thread, each with the help of the "
+                              "frames before it (--track-frames in all); a frame without a pose within 20 ms starts "
+                              "the track again")
                     ->check(CLI::ExistingFile)
                     ->excludes(near);
   r->add_option("--track-frames", a.track_frames, "with --track: the newest frames kept in the track")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1000))
+      ->check(CLI::Range(1, 100))
       ->needs(track);
 }
 

@@ -16,7 +16,7 @@ namespace ellreloc {
 using namespace pipeline;
 
 std::string TrackOptions::validate() const {
-  if (max_frames < 1 || max_frames > 1000) return "max_frames is not in [1, 1000]";
+  if (max_frames < 1 || max_frames > 100) return "max_frames is not in [1, 100]";
   if (!std::isfinite(min_mean_evidence)) return "min_mean_evidence is not finite";
   if (!(min_margin >= 0.0)) return "min_margin is negative or not a number";
   return "";

@@ -25,7 +25,7 @@ namespace ellreloc {
 struct TrackOptions {
   /// The newest frames kept in the track. A longer track sees more of the room, but carries the
   /// poses further on the odometry's drift; a frame's work grows with it (its poses are scored
-  /// on every frame, every kept pose on it).
+  /// on every frame, every kept pose on it), and the memory with its square. At most 100.
   int max_frames = 10;
   /// With the relocalizer's acceptance test on (acceptance.enabled), a pose is Success only when
   /// the track's frames' evidence at it sums to acceptance.min_evidence and averages at least
