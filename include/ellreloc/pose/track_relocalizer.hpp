@@ -32,8 +32,8 @@ struct TrackOptions {
   /// `min_mean_evidence` per frame (a look-alike pose explains a few of each frame's
   /// observations, the right one most of them), and when the best other pose the track's frames
   /// found (30 cm or 30 degrees away) costs at least `min_margin` more over the track. Chosen on
-  /// fr2_desk and nine fr3 splits, tracks of 3-20 frames: fewer wrong poses than each frame alone
-  /// on every one, and more right ones (docs/benchmarks.md, "Over a track").
+  /// fr2_desk and nine fr3 splits, tracks of 3-20 frames: no more wrong poses than each frame
+  /// alone on any of them, and more right ones (docs/benchmarks.md, "Over a track").
   double min_mean_evidence = 1.5;
   double min_margin = 0.5;
   /// Why the options are unusable, or empty.
