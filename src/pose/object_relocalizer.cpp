@@ -44,8 +44,7 @@ void reportMatches(const std::vector<ObjectCorrespondence>& matches, int usable,
   for (const ObjectCorrespondence& m : matches) sum += m.overlap;
   result->inliers = matches;
   result->mean_overlap = matches.empty() ? 0.0 : sum / static_cast<double>(matches.size());
-  const int unexplained = std::max(0, usable - static_cast<int>(matches.size()));
-  result->evidence = sum - acceptance.unexplained_penalty * unexplained;
+  result->evidence = matchEvidence(matches, usable, acceptance);
 }
 
 /// Keypoints whose index names a finite map point, as the refiner's point matches.

@@ -9,6 +9,7 @@
 
 #include "ellreloc/core/evaluation.hpp"
 #include "pipeline/candidates.hpp"
+#include "pipeline/hypothesis_pool.hpp"
 #include "pipeline/pose_scorer.hpp"
 
 namespace ellreloc {
@@ -39,24 +40,6 @@ struct TrackRelocalizer::Frame {
   long first = 0;  // the number of the oldest frame of the track when this one joined
 };
 
-namespace {
-
-/// Carried poses this close count as one: the pool's distinct-hypothesis bounds.
-bool samePose(const Pose& a, const Pose& b) {
-  const PoseError e = poseError(a, b);
-  return e.position_cm < 5.0 && e.rotation_deg < 3.0;
-}
-
-/// What a frame's matches are worth as evidence (AcceptanceOptions): their overlaps, less the
-/// penalty per usable observation they leave unexplained.
-double evidenceOf(const std::vector<ObjectCorrespondence>& matches, int usable, const AcceptanceOptions& acceptance) {
-  double sum = 0.0;
-  for (const ObjectCorrespondence& m : matches) sum += m.overlap;
-  return sum - acceptance.unexplained_penalty * std::max(0, usable - static_cast<int>(matches.size()));
-}
-
-}  // namespace
-
 TrackRelocalizer::TrackRelocalizer(const ObjectRelocalizer& relocalizer, TrackOptions options)
     : relocalizer_(relocalizer), options_(options) {}
 
@@ -74,7 +57,7 @@ TrackRelocalizer::TrackScore TrackRelocalizer::score(const Pose& pose, bool with
     const Pose at = frame->odometry * newest.inverse() * pose;
     s.cost += frame->scorer->cost(at, vertices, with_evidence ? &matches : nullptr);
     if (with_evidence) {
-      s.evidence += evidenceOf(matches, frame->candidates.num_usable, relocalizer_.options().acceptance);
+      s.evidence += matchEvidence(matches, frame->candidates.num_usable, relocalizer_.options().acceptance);
       s.matches += static_cast<int>(matches.size());
     }
   }
@@ -124,7 +107,8 @@ std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses() const {
     const Pose back = (f.odometry * newest.inverse()).inverse();  // the frame's pose -> the newest's
     for (const Frame::Found& p : f.found) {
       const Pose pose = back * p.pose;
-      if (std::any_of(carried.begin(), carried.end(), [&](const Carried& c) { return samePose(c.pose, pose); }))
+      if (std::any_of(carried.begin(), carried.end(),
+                      [&](const Carried& c) { return sameNeighbourhood(c.pose, pose); }))
         continue;
       double cost = 0.0;  // over the frames the track holds now
       for (long j = oldest; j <= frames_.back()->serial; ++j) cost += p.costs[static_cast<size_t>(j - f.first)];

@@ -10,7 +10,12 @@
 
 namespace ellreloc::pipeline {
 
-/// Keeps the `capacity` lowest-cost poses, at most one per neighbourhood (5 cm, 3 degrees):
+/// Two poses count as one hypothesis: centres within 5 cm, rotations within 3 degrees.
+inline bool sameNeighbourhood(const Pose& a, const Pose& b) {
+  return (a.center() - b.center()).norm() < 0.05 && rotationErrorDeg(a.rotation(), b.rotation()) < 3.0;
+}
+
+/// Keeps the `capacity` lowest-cost poses, at most one per neighbourhood (sameNeighbourhood):
 /// the best raw hypothesis is often not the one that refines best, and near-duplicates of it
 /// would crowd out the alternatives.
 class HypothesisPool {
@@ -20,8 +25,7 @@ class HypothesisPool {
   void offer(const Pose& pose, double cost) {
     if (entries_.size() == capacity_ && cost >= entries_.back().cost) return;
     for (ScoredPose& h : entries_) {
-      if ((h.pose.center() - pose.center()).norm() < 0.05 &&
-          rotationErrorDeg(h.pose.rotation(), pose.rotation()) < 3.0) {
+      if (sameNeighbourhood(h.pose, pose)) {
         if (cost < h.cost) h = {pose, cost};
         sortByCost();
         return;

@@ -2,6 +2,7 @@
 // The one cost of the relocalization pipeline: every stage (sample checks, RANSAC, the few-object
 // poses, refinement, scorePose) ranks poses with it.
 
+#include <algorithm>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -17,6 +18,15 @@ namespace ellreloc::pipeline {
 /// rank poses and 3x faster than 128); the refinement and the result use kReportIoUVertices.
 constexpr int kRankingIoUVertices = 32;
 constexpr int kReportIoUVertices = 128;
+
+/// What a pose's matches are worth as evidence among `usable` observations (AcceptanceOptions):
+/// their overlaps, less the penalty per usable observation they leave unexplained.
+inline double matchEvidence(const std::vector<ObjectCorrespondence>& matches, int usable,
+                            const AcceptanceOptions& acceptance) {
+  double sum = 0.0;
+  for (const ObjectCorrespondence& m : matches) sum += m.overlap;
+  return sum - acceptance.unexplained_penalty * std::max(0, usable - static_cast<int>(matches.size()));
+}
 
 /// Projections already computed at the pose being scored (a hypothesis's own objects).
 struct KnownProjections {
