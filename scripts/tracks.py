@@ -31,6 +31,7 @@ import tempfile
 
 from fr3_splits import splits  # noqa: E402
 from null_frames import image_size, moved_boxes  # noqa: E402
+from pose_regions import valid_and_time  # noqa: E402
 from real_data import box_map, data, fr3, run  # noqa: E402  (same arguments as real_data.py)
 
 DRIFTS = [("exact", 0.0, 0.0), ("drift 2%, 1 deg/m", 0.02, 1.0), ("drift 5%, 3 deg/m", 0.05, 3.0)]
@@ -84,25 +85,13 @@ def write_tum(rows, path):
             f.write("%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n" % ((stamp,) + p + q))
 
 
-def reloc(camera, map_path, detections, groundtruth, work, extra):
-    """Valid share and wrong poses of the reported poses, and the median time per frame."""
-    out = os.path.join(work, "poses.txt")
-    printed = run("relocalize", "--camera", camera, "--map", map_path, "--detections", detections, "--threads", "1",
-                  "--out", out, *extra)
-    ms = float(re.search(r"median ([0-9.]+) ms per frame", printed).group(1))
-    row = run("evaluate", "--groundtruth", groundtruth, "--estimate", out, "--detections", detections)
-    valid, posed = [c.strip() for c in row.strip().splitlines()[-1].strip("|").split("|")][2:4]
-    posed, frames = [int(x) for x in posed.split("/")]
-    return "%s%% (%d wrong)" % (valid, posed - round(float(valid) * frames / 100.0)), ms
-
-
 def rows_of(name, camera, map_path, detections, groundtruth, lengths, work):
     """The frames alone, then along tracks of each length on each odometry."""
     truth = read_tum(groundtruth)
 
     def row(track, odometry, extra):
-        default, ms = reloc(camera, map_path, detections, groundtruth, work, extra)
-        every, _ = reloc(camera, map_path, detections, groundtruth, work, extra + ["--accept-all"])
+        default, ms = valid_and_time(camera, map_path, detections, groundtruth, work, extra)
+        every, _ = valid_and_time(camera, map_path, detections, groundtruth, work, extra + ["--accept-all"])
         print("| %s | %s | %s | %s | %s | %.1f ms |" % (name, track, odometry, default, every, ms), flush=True)
 
     row("alone", "", [])
