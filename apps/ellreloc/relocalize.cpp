@@ -357,6 +357,8 @@ std::vector<std::optional<Pose>> trackPoses(const RelocalizeArgs& a, const std::
     else
       ++*without;
   }
+  if (*without == timestamps.size() && !timestamps.empty())  // another sequence's poses, or other clock
+    throw Error("--track: no frame has a pose in " + a.track + " within 20 ms of its timestamp");
   return poses;
 }
 

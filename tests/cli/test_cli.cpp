@@ -471,6 +471,9 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                              d + "/keyframes.groundtruth.txt --near " + d + "/keyframes.groundtruth.txt"},
       {"track and points", reloc + "--map " + d + "/map.json --detections " + d +
                                "/keyframes.detections.json --track " + d + "/keyframes.groundtruth.txt --points"},
+      {"odometry of other frames", reloc + "--map " + d + "/map.json --detections " + d +
+                                       "/keyframes.detections.json --track " + data("tum_fr3_office_first_half") +
+                                       "/groundtruth.txt"},
       {"odometry that is not a trajectory", reloc + "--map " + d + "/map.json --detections " + d +
                                                 "/keyframes.detections.json --track " + dir.path("truncated.json")},
       {"gravity sigma without directions",
