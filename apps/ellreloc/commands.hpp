@@ -89,11 +89,13 @@ struct RelocalizeArgs {
   std::string near;
   double near_radius_m = PoseRegion().radius_m;
   double near_angle_deg = PoseRegion().max_rotation_deg;
-  /// TUM poses from the host's own odometry (camera->world in its frame, metric): the frames are
+  /// TUM poses from the host's own odometry (camera->world in its frame): the frames are
   /// relocalized in timestamp order as one track (TrackRelocalizer); a frame without a pose within
   /// 20 ms of its timestamp is relocalized alone and starts the track again. Empty: none.
   std::string track;
   int track_frames = TrackOptions().max_frames;
+  /// The --track odometry's scale is unknown (a monocular host's): the track estimates it.
+  bool track_scale_unknown = false;
 };
 /// `use_points` is set after parsing, from whether --points was given.
 CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a);

@@ -76,7 +76,8 @@ void addPriorOptions(CLI::App* r, RelocalizeArgs& a) {
       ->check(CLI::Range(0.0, 180.0))
       ->needs(near);
   auto* track = r->add_option("--track", a.track,
-                              "TUM poses from your own odometry (camera->world in its frame, metric): the frames are "
+                              "TUM poses from your own odometry (camera->world in its frame, metric unless "
+                              "--track-scale-unknown): the frames are "
                               "relocalized in timestamp order as one track, on one thread, each with the help of the "
                               "frames before it (--track-frames in all); a frame without a pose within 20 ms starts "
                               "the track again")
@@ -85,6 +86,10 @@ void addPriorOptions(CLI::App* r, RelocalizeArgs& a) {
   r->add_option("--track-frames", a.track_frames, "with --track: the newest frames kept in the track")
       ->capture_default_str()
       ->check(CLI::Range(1, 100))
+      ->needs(track);
+  r->add_flag("--track-scale-unknown", a.track_scale_unknown,
+              "with --track: the odometry's scale is unknown (a monocular SLAM map's); the track estimates it and the "
+              "report gives it as track.scale")
       ->needs(track);
 }
 
@@ -533,6 +538,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   std::vector<std::optional<TrackResult>> tracks(frames.size());
   TrackOptions track_options;
   track_options.max_frames = a.track_frames;
+  track_options.metric_odometry = !a.track_scale_unknown;
   const std::vector<RelocalizationResult> results =
       a.track.empty() ? relocalizeFrames(relocalizer, frames, keypoints, gravity, regions, observe_options, references,
                                          a.threads, console, &observations, &reference_scores)
@@ -553,8 +559,13 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     nlohmann::json j = frameReport(frames[i], r, static_cast<int>(observations[i].size()), object_map, reference,
                                    reference_scores[i], diagnosis);
     if (const std::optional<TrackResult>& t = tracks[i])
-      j["track"] = {{"frames", t->frames},         {"cost", t->track_cost},       {"evidence", t->track_evidence},
-                    {"matches", t->track_matches}, {"candidates", t->candidates}, {"found_by", t->found_by}};
+      j["track"] = {{"frames", t->frames},
+                    {"cost", t->track_cost},
+                    {"evidence", t->track_evidence},
+                    {"matches", t->track_matches},
+                    {"candidates", t->candidates},
+                    {"found_by", t->found_by},
+                    {"scale", t->scale}};
     report.push_back(j);
     if (r.status == RelocalizationStatus::Success) poses.push_back({timestamps[i], r.pose, frames[i].timestampText()});
   }

@@ -668,8 +668,8 @@ class Summary:
 
 class TrackRelocalizer:
     """Relocalizes each new frame of a track a host follows without the map (its odometry gives each frame's pose): every frame's poses, carried to the newest frame, ranked over the whole track (docs/pose.md, 'Over a track')."""
-    def __init__(self, relocalizer: object, max_frames: int = ..., min_mean_evidence: float = ..., min_margin: float = ...) -> None: ...
-    def add(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], odometry_pose: Pose, gravity: Optional[GravityPrior] = ...) -> TrackResult: """Adds a frame (a DetectionFrame, or a list of Detection or Observation) with its camera pose in the odometry's frame (world->camera, metric) and relocalizes it with the track's help; an invalid pose leaves the track unchanged (status invalid_input)."""
+    def __init__(self, relocalizer: object, max_frames: int = ..., min_mean_evidence: float = ..., min_margin: float = ..., metric_odometry: bool = ...) -> None: """metric_odometry=False for a monocular host's odometry, whose scale is unknown: the track estimates it (TrackResult.scale)."""
+    def add(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], odometry_pose: Pose, gravity: Optional[GravityPrior] = ...) -> TrackResult: """Adds a frame (a DetectionFrame, or a list of Detection or Observation) with its camera pose in the odometry's frame (world->camera; metric unless metric_odometry=False) and relocalizes it with the track's help; an invalid pose leaves the track unchanged (status invalid_input)."""
     def reset(self) -> None: """Forgets every frame (the odometry restarted)."""
     def __len__(self) -> int: ...
 
@@ -683,6 +683,7 @@ class TrackResult:
     frames: int
     candidates: int
     found_by: int
+    scale: float
 
 
 class TrackingOptions:

@@ -495,10 +495,15 @@ void bindTrack(py::module_& m) {
       .def_readonly("track_evidence", &TrackResult::track_evidence,
                     "The sum over the track's frames of their evidence at the pose (the acceptance test reads it).")
       .def_readonly("track_matches", &TrackResult::track_matches, "Observations explained over the track's frames.")
-      .def_readonly("frames", &TrackResult::frames, "Frames in the track, this one included.")
+      .def_readonly("frames", &TrackResult::frames,
+                    "Frames whose observations ranked the poses, this one included (only this one while an unknown "
+                    "odometry scale has no estimate).")
       .def_readonly("candidates", &TrackResult::candidates, "Distinct poses ranked.")
       .def_readonly("found_by", &TrackResult::found_by,
                     "Whose search found the pose: 0 this frame, 1 the one before, ...; -1 when none did.")
+      .def_readonly("scale", &TrackResult::scale,
+                    "Map metres per odometry unit the poses were carried with: 1 with metric odometry, else the "
+                    "estimate (0 while there is none).")
       .def("__repr__", [](const TrackResult& t) {
         return std::string("TrackResult(") + py::str(py::cast(t.result.status)).cast<std::string>() + ", " +
                std::to_string(t.frames) + " frames, found by " + std::to_string(t.found_by) + ")";
@@ -507,9 +512,11 @@ void bindTrack(py::module_& m) {
                     "Relocalizes each new frame of a track a host follows without the map (its odometry gives each "
                     "frame's pose): every frame's poses, carried to the newest frame, ranked over the whole track "
                     "(docs/pose.md, 'Over a track').")
-      .def(py::init([](py::object relocalizer, int max_frames, double min_mean_evidence, double min_margin) {
+      .def(py::init([](py::object relocalizer, int max_frames, double min_mean_evidence, double min_margin,
+                       bool metric_odometry) {
              TrackOptions options;
              options.max_frames = max_frames;
+             options.metric_odometry = metric_odometry;
              options.min_mean_evidence = min_mean_evidence;
              options.min_margin = min_margin;
              if (const std::string why = options.validate(); !why.empty()) badArgument("TrackRelocalizer", why);
@@ -518,7 +525,10 @@ void bindTrack(py::module_& m) {
            }),
            py::arg("relocalizer"), py::arg("max_frames") = TrackOptions().max_frames,
            py::arg("min_mean_evidence") = TrackOptions().min_mean_evidence,
-           py::arg("min_margin") = TrackOptions().min_margin)
+           py::arg("min_margin") = TrackOptions().min_margin,
+           py::arg("metric_odometry") = TrackOptions().metric_odometry,
+           "metric_odometry=False for a monocular host's odometry, whose scale is unknown: the track estimates it "
+           "(TrackResult.scale).")
       .def(
           "add",
           [](Track& t, const py::handle& frame, const Pose& odometry_pose, const std::optional<GravityPrior>& gravity) {
@@ -528,8 +538,8 @@ void bindTrack(py::module_& m) {
           },
           py::arg("frame"), py::arg("odometry_pose"), py::arg("gravity") = py::none(),
           "Adds a frame (a DetectionFrame, or a list of Detection or Observation) with its camera pose in the "
-          "odometry's frame (world->camera, metric) and relocalizes it with the track's help; an invalid pose "
-          "leaves the track unchanged (status invalid_input).")
+          "odometry's frame (world->camera; metric unless metric_odometry=False) and relocalizes it with the "
+          "track's help; an invalid pose leaves the track unchanged (status invalid_input).")
       .def(
           "reset", [](Track& t) { t.track->reset(); }, "Forgets every frame (the odometry restarted).")
       .def("__len__", [](const Track& t) { return t.track->size(); });

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <unordered_map>
 
 #include "ellreloc/core/evaluation.hpp"
 #include "pipeline/candidates.hpp"
@@ -15,6 +17,20 @@
 namespace ellreloc {
 
 using namespace pipeline;
+
+namespace {
+
+/// The unknown scale is searched in steps of 10% (in its logarithm), up to 4 steps (a factor 1.5)
+/// either side of the one the frames' poses propose: a proposal, from poses centimetres to
+/// decimetres off, is itself within a few steps of the scale.
+constexpr double kScaleStep = 0.1;
+constexpr int kScaleSearchSteps = 4;
+
+/// An odometry pose with its translation in map metres: the camera centre scaled about the
+/// odometry's origin.
+Pose scaled(const Pose& odometry, double scale) { return Pose(odometry.rotation(), scale * odometry.translation()); }
+
+}  // namespace
 
 std::string TrackOptions::validate() const {
   if (max_frames < 1 || max_frames > 100) return "max_frames is not in [1, 100]";
@@ -29,32 +45,53 @@ struct TrackRelocalizer::Frame {
   std::unique_ptr<PoseScorer> scorer;  // reads `observations` and `candidates`
   Pose odometry;                       // world -> camera in the odometry's frame
   long serial = 0;                     // frames are numbered as they join
-  /// A pose its own search found (its pose, then its alternatives), with its cost on each frame
-  /// of the track: `costs[j - first]` on frame number j. A frame's pose is a fixed pose of every
-  /// other frame (O_j O_k^-1 P_k), so each cost is computed once, when the later of the two joins.
+  /// A pose its own search found (its pose, then its alternatives), with its costs on the
+  /// track's frames. At one scale a frame's pose is a fixed pose of every other frame
+  /// (O_j O_k^-1 P_k), so each cost is computed once, when first needed: `costs` holds them by
+  /// the frame's serial and the scale step.
   struct Found {
     Pose pose;
-    std::vector<double> costs;
+    mutable std::unordered_map<std::uint64_t, double> costs;
   };
   std::vector<Found> found;
-  long first = 0;  // the number of the oldest frame of the track when this one joined
+
+  /// The cost of `by`'s pose `p` on this frame, carried at `scale_step`.
+  double costOf(const Found& p, const Frame& by, int scale_step) const {
+    const std::uint64_t key =
+        (static_cast<std::uint64_t>(serial) << 20) ^ static_cast<std::uint64_t>(scale_step + (1 << 19));
+    const auto known = p.costs.find(key);
+    if (known != p.costs.end()) return known->second;
+    const double scale = std::exp(kScaleStep * scale_step);
+    const double cost =
+        scorer->cost(scaled(odometry, scale) * scaled(by.odometry, scale).inverse() * p.pose, kRankingIoUVertices);
+    p.costs.emplace(key, cost);
+    return cost;
+  }
 };
+
+double TrackRelocalizer::Carrying::scale() const { return std::exp(kScaleStep * scale_step); }
 
 TrackRelocalizer::TrackRelocalizer(const ObjectRelocalizer& relocalizer, TrackOptions options)
     : relocalizer_(relocalizer), options_(options) {}
 
 TrackRelocalizer::~TrackRelocalizer() = default;
 
-void TrackRelocalizer::reset() { frames_.clear(); }
+void TrackRelocalizer::reset() {
+  frames_.clear();
+  last_scale_step_.reset();
+}
 
-TrackRelocalizer::TrackScore TrackRelocalizer::score(const Pose& pose, bool with_evidence) const {
+TrackRelocalizer::TrackScore TrackRelocalizer::score(const Pose& pose, bool with_evidence,
+                                                     const Carrying& carrying) const {
   TrackScore s;
-  const Pose& newest = frames_.back()->odometry;
+  const double scale = carrying.scale();
+  const Pose newest = scaled(frames_.back()->odometry, scale);
   const int vertices = with_evidence ? kReportIoUVertices : kRankingIoUVertices;
   std::vector<ObjectCorrespondence> matches;
-  for (const std::unique_ptr<Frame>& frame : frames_) {
+  for (size_t k = static_cast<size_t>(carrying.first); k < frames_.size(); ++k) {
+    const Frame* frame = frames_[k].get();
     // x_frame = odometry_frame odometry_newest^-1 x_newest, so the frame's pose is that times `pose`.
-    const Pose at = frame->odometry * newest.inverse() * pose;
+    const Pose at = scaled(frame->odometry, scale) * newest.inverse() * pose;
     s.cost += frame->scorer->cost(at, vertices, with_evidence ? &matches : nullptr);
     if (with_evidence) {
       s.evidence += matchEvidence(matches, frame->candidates.num_usable, relocalizer_.options().acceptance);
@@ -83,40 +120,99 @@ void TrackRelocalizer::join(const std::vector<Observation>& observations, const 
   }
   frames_.push_back(std::move(frame));
   while (size() > options_.max_frames) frames_.pop_front();
-
-  // The costs that are new: the older frames' poses on this frame, this frame's on every frame.
-  Frame& added = *frames_.back();
-  added.first = frames_.front()->serial;
-  const auto cost = [](const Frame& on, const Frame& by, const Pose& pose) {  // `by`'s pose, on frame `on`
-    return on.scorer->cost(on.odometry * by.odometry.inverse() * pose, kRankingIoUVertices);
-  };
-  for (const std::unique_ptr<Frame>& f : frames_) {
-    if (f.get() == &added) continue;
-    for (Frame::Found& p : f->found) p.costs.push_back(cost(added, *f, p.pose));
-  }
-  for (Frame::Found& p : added.found)
-    for (const std::unique_ptr<Frame>& f : frames_) p.costs.push_back(cost(*f, added, p.pose));
 }
 
-std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses() const {
-  const Pose& newest = frames_.back()->odometry;
-  const long oldest = frames_.front()->serial;
+std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses(const Carrying& carrying) const {
+  const double scale = carrying.scale();
+  const Pose newest = scaled(frames_.back()->odometry, scale);
   std::vector<Carried> carried;
-  for (int k = size() - 1; k >= 0; --k) {  // newest first: of equal costs, the newest frame's pose wins
+  for (int k = size() - 1; k >= carrying.first; --k) {  // newest first: of equal costs, the newest frame's pose wins
     const Frame& f = *frames_[static_cast<size_t>(k)];
-    const Pose back = (f.odometry * newest.inverse()).inverse();  // the frame's pose -> the newest's
+    const Pose back = (scaled(f.odometry, scale) * newest.inverse()).inverse();  // the frame's pose -> the newest's
     for (const Frame::Found& p : f.found) {
       const Pose pose = back * p.pose;
       if (std::any_of(carried.begin(), carried.end(),
                       [&](const Carried& c) { return sameNeighbourhood(c.pose, pose); }))
         continue;
-      double cost = 0.0;  // over the frames the track holds now
-      for (long j = oldest; j <= frames_.back()->serial; ++j) cost += p.costs[static_cast<size_t>(j - f.first)];
+      double cost = 0.0;  // over the frames carried
+      for (int j = carrying.first; j < size(); ++j)
+        cost += frames_[static_cast<size_t>(j)]->costOf(p, f, carrying.scale_step);
       carried.push_back({pose, size() - 1 - k, cost});
     }
   }
   std::stable_sort(carried.begin(), carried.end(), [](const Carried& a, const Carried& b) { return a.cost < b.cost; });
   return carried;
+}
+
+double TrackRelocalizer::proposedScale() const {
+  // Two frames whose own poses turn as the odometry does (within 10 degrees) and move the way it
+  // does in the first frame's camera (within 20 degrees) propose the ratio of the distances
+  // between their cameras. Only pairs far apart for the track (a quarter of its widest span in
+  // the odometry) and in the map (20 cm, beyond the poses' errors) propose. The proposals
+  // weigh as their odometry baselines; the heaviest cluster (within 10%) gives the scale.
+  double widest = 0.0;
+  for (const auto& a : frames_)
+    for (const auto& b : frames_) widest = std::max(widest, (a->odometry.center() - b->odometry.center()).norm());
+  if (!(widest > 0.0)) return 0.0;
+  struct Proposal {
+    double log_scale, weight;
+  };
+  std::vector<Proposal> proposals;
+  for (size_t j = 0; j < frames_.size(); ++j)
+    for (size_t k = j + 1; k < frames_.size(); ++k) {
+      const Pose& oj = frames_[j]->odometry;
+      const Pose& ok = frames_[k]->odometry;
+      const Eigen::Vector3d moved = ok.center() - oj.center();
+      const double baseline = moved.norm();
+      if (baseline < 0.25 * widest) continue;
+      const Eigen::Matrix3d turned = ok.rotation() * oj.rotation().transpose();
+      const Eigen::Vector3d way = oj.rotation() * moved / baseline;  // in frame j's camera
+      for (const Frame::Found& a : frames_[j]->found)
+        for (const Frame::Found& b : frames_[k]->found) {
+          const Eigen::Vector3d map_moved = b.pose.center() - a.pose.center();
+          const double distance = map_moved.norm();
+          if (distance < 0.2) continue;
+          if (rotationErrorDeg(b.pose.rotation() * a.pose.rotation().transpose(), turned) > 10.0) continue;
+          if ((a.pose.rotation() * map_moved / distance).dot(way) < std::cos(20.0 * M_PI / 180.0)) continue;
+          proposals.push_back({std::log(distance / baseline), baseline / widest});
+        }
+    }
+  double best_weight = 0.0, best_sum = 0.0;
+  for (const Proposal& p : proposals) {
+    double weight = 0.0, sum = 0.0;
+    for (const Proposal& q : proposals)
+      if (std::abs(q.log_scale - p.log_scale) < 0.1) weight += q.weight, sum += q.weight * q.log_scale;
+    if (weight > best_weight) best_weight = weight, best_sum = sum;
+  }
+  return best_weight > 0.0 ? std::exp(best_sum / best_weight) : 0.0;
+}
+
+TrackRelocalizer::Carrying TrackRelocalizer::chooseCarrying(std::vector<Carried>* ranked) {
+  if (options_.metric_odometry) {
+    *ranked = rankedPoses(Carrying{});
+    return Carrying{};
+  }
+  const double proposed = proposedScale();
+  const std::optional<int> centre =
+      proposed > 0.0 ? std::optional<int>(static_cast<int>(std::lround(std::log(proposed) / kScaleStep)))
+                     : last_scale_step_;
+  if (!centre) {  // no scale yet: the newest frame's poses on it alone
+    const Carrying alone{0, size() - 1, false};
+    *ranked = rankedPoses(alone);
+    return alone;
+  }
+  Carrying best{*centre, 0};
+  ranked->clear();
+  for (int d = 0; d <= 2 * kScaleSearchSteps; ++d) {  // centre, -1, +1, -2, ...: of equal costs, the nearer
+    const Carrying c{*centre + (d % 2 == 0 ? d / 2 : -(d + 1) / 2), 0};
+    std::vector<Carried> poses = rankedPoses(c);
+    if (!poses.empty() && (ranked->empty() || poses.front().cost < ranked->front().cost)) {
+      best = c;
+      *ranked = std::move(poses);
+    }
+  }
+  last_scale_step_ = best.scale_step;
+  return best;
 }
 
 TrackResult TrackRelocalizer::add(const std::vector<Observation>& observations, const Pose& odometry_pose,
@@ -134,9 +230,11 @@ TrackResult TrackRelocalizer::add(const std::vector<Observation>& observations, 
   out.result = relocalizer_.relocalize(observations, {}, gravity);
   if (out.result.status == RelocalizationStatus::InvalidInput) return out;
   join(observations, odometry_pose, out.result);
-  out.frames = size();
 
-  const std::vector<Carried> ranked = rankedPoses();
+  std::vector<Carried> ranked;
+  const Carrying carrying = chooseCarrying(&ranked);
+  out.frames = size() - carrying.first;
+  out.scale = carrying.known ? carrying.scale() : 0.0;
   out.candidates = static_cast<int>(ranked.size());
   if (!ranked.empty()) {  // else no frame of the track gave a pose: this frame's own answer says why
     out.found_by = ranked.front().found_by;
@@ -144,9 +242,9 @@ TrackResult TrackRelocalizer::add(const std::vector<Observation>& observations, 
     Pose pose = ranked.front().pose;
     const RelocalizationResult refined = relocalizer_.refineFrom(observations, pose);
     const bool keep_refined =
-        refined.refined && refined.pose.isValid() && score(refined.pose, false).cost <= ranked.front().cost;
+        refined.refined && refined.pose.isValid() && score(refined.pose, false, carrying).cost <= ranked.front().cost;
     if (keep_refined) pose = refined.pose;
-    report(observations, pose, ranked, &out);
+    report(observations, pose, ranked, carrying, &out);
     out.result.refined = keep_refined;
   }
   out.result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -154,7 +252,7 @@ TrackResult TrackRelocalizer::add(const std::vector<Observation>& observations, 
 }
 
 void TrackRelocalizer::report(const std::vector<Observation>& observations, const Pose& pose,
-                              const std::vector<Carried>& ranked, TrackResult* out) const {
+                              const std::vector<Carried>& ranked, const Carrying& carrying, TrackResult* out) const {
   const RelocalizationResult at = relocalizer_.scorePose(observations, pose);
   RelocalizationResult& result = out->result;
   result.pose = pose;
@@ -162,7 +260,7 @@ void TrackRelocalizer::report(const std::vector<Observation>& observations, cons
   result.cost = at.cost;
   result.mean_overlap = at.mean_overlap;
   result.evidence = at.evidence;
-  const TrackScore track = score(pose, true);
+  const TrackScore track = score(pose, true, carrying);
   out->track_cost = track.cost;
   out->track_evidence = track.evidence;
   out->track_matches = track.matches;

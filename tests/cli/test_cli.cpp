@@ -464,6 +464,8 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                                                    "/keyframes.detections.json --near " + dir.path("truncated.json")},
       {"track frames without odometry",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --track-frames 5"},
+      {"unknown track scale without odometry",
+       reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --track-scale-unknown"},
       {"track frames of zero", reloc + "--map " + d + "/map.json --detections " + d +
                                    "/keyframes.detections.json --track " + d +
                                    "/keyframes.groundtruth.txt --track-frames 0"},

@@ -2,6 +2,8 @@
 // a gravity prior and a pose region, or a track of two frames along odometry poses from the
 // numbers): a status, never a crash, and a successful pose is a valid rigid transform, within
 // the region when there is one.
+#include <cmath>
+
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/pose/track_relocalizer.hpp"
 #include "fuzz_input.hpp"
@@ -55,6 +57,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (in.small(2) == 1) {  // the frame twice along a track, the odometry poses from the numbers
     TrackOptions track_options;
     track_options.max_frames = 1 + in.small(2);
+    track_options.metric_odometry = in.small(2) == 0;
     TrackRelocalizer track(relocalizer, track_options);
     for (int k = 0; k < 2; ++k) {
       const Pose odometry(Eigen::AngleAxisd(num(-4, 4), Eigen::Vector3d::UnitY()).toRotationMatrix(),
@@ -62,8 +65,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const int before = track.size();
       const TrackResult t = track.add(observations, odometry, gravity);
       FUZZ_CHECK(t.result.status != RelocalizationStatus::Success || t.result.pose.isValid());
-      FUZZ_CHECK(odometry.isValid() || (t.result.status == RelocalizationStatus::InvalidInput && track.size() == before));
+      FUZZ_CHECK(odometry.isValid() ||
+                 (t.result.status == RelocalizationStatus::InvalidInput && track.size() == before));
       FUZZ_CHECK(track.size() <= track_options.max_frames);
+      FUZZ_CHECK(std::isfinite(t.scale) && t.scale >= 0.0 && (track_options.metric_odometry ? t.scale == 1.0 : true));
     }
   }
   return 0;

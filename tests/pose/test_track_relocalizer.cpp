@@ -179,3 +179,44 @@ TEST(TrackRelocalizer, TracksOfRandomBoxesGetNoPose) {
   }
   EXPECT_EQ(reported, 0) << "of " << frames << " frames";
 }
+
+TEST(TrackRelocalizer, EstimatesTheScaleOfAMonocularOdometry) {
+  // A monocular host's odometry: the map's world through an arbitrary motion and in units of its
+  // own (here 0.3 of a metre each). The plant view, then two views of the desk alone, which its
+  // twin explains as well: the track must find the scale to carry the plant view to them.
+  const ObjectMap map = desksAndAPlant();
+  const ObjectRelocalizer relocalizer(map, test::testIntrinsics());
+  constexpr double kUnit = 0.3;
+  std::mt19937 rng(5);
+  int trials = 0;
+  while (trials < 5) {
+    std::vector<int> ids_a, ids_b, ids_c;
+    const Pose truth_a = plantView(rng), truth_b = deskView(rng), truth_c = deskView(rng);
+    const std::vector<Observation> a = observe(map, truth_a, rng, &ids_a);
+    const std::vector<Observation> b = observe(map, truth_b, rng, &ids_b);
+    const std::vector<Observation> c = observe(map, truth_c, rng, &ids_c);
+    if (!holds(ids_a, kPlantId) || a.size() < 4 || b.size() < 4 || c.size() < 4 || holds(ids_b, kPlantId) ||
+        holds(ids_c, kPlantId))
+      continue;
+    ++trials;
+    const Pose odometry_to_world = arbitraryMotion(rng);
+    const auto odometry = [&](const Pose& truth) {
+      const Pose metric = odometryOf(truth, odometry_to_world);
+      return Pose(metric.rotation(), metric.translation() / kUnit);
+    };
+    TrackOptions options;
+    options.metric_odometry = false;
+    TrackRelocalizer track(relocalizer, options);
+    const TrackResult first = track.add(a, odometry(truth_a));
+    EXPECT_EQ(first.frames, 1);  // no scale before two frames propose one
+    EXPECT_EQ(first.scale, 0.0);
+    track.add(b, odometry(truth_b));
+    const TrackResult r = track.add(c, odometry(truth_c));
+    ASSERT_EQ(r.result.status, RelocalizationStatus::Success) << r.result.reason;
+    EXPECT_EQ(r.frames, 3);
+    EXPECT_NEAR(std::log(r.scale / kUnit), 0.0, 0.15) << "scale " << r.scale;
+    EXPECT_LT(poseError(r.result.pose, truth_c).position_cm, 1.0);
+    EXPECT_LT(poseError(r.result.pose, truth_c).rotation_deg, 0.2);
+    EXPECT_GT(r.result.margin, 0.5);  // the plant view rules the twin out
+  }
+}
