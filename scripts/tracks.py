@@ -11,7 +11,9 @@ TrackRelocalizer): each query frame is relocalized with the help of the frames b
 
 The odometry is the motion-capture trajectory, exact or drifting as a visual odometry does: each
 step's translation scaled by 1 + s and turned by b degrees per metre travelled about one fixed
-axis (s = 2%, b = 1; and s = 5%, b = 3), accumulated along the whole sequence. Rows: each frame
+axis (s = 2%, b = 1; and s = 5%, b = 3), accumulated along the whole sequence. A monocular
+odometry has a unit of its own: the same trajectories in units of 0.37 m, with the scale left to
+the track (`--track-scale-unknown`), and once read as if metric. Rows: each frame
 alone, then along the track; ours by default and reporting every pose (`--accept-all`), each
 with its wrong poses (off by 30 cm or 30 deg or more), and the median time per frame (one
 thread, the frame's own search included).
@@ -35,6 +37,7 @@ from pose_regions import valid_and_time  # noqa: E402
 from real_data import box_map, data, fr3, run  # noqa: E402  (same arguments as real_data.py)
 
 DRIFTS = [("exact", 0.0, 0.0), ("drift 2%, 1 deg/m", 0.02, 1.0), ("drift 5%, 3 deg/m", 0.05, 3.0)]
+MONOCULAR_UNIT = 0.37  # metres per unit of the monocular odometry
 AXIS = (1 / math.sqrt(14), 2 / math.sqrt(14), 3 / math.sqrt(14))  # the fixed axis of the rotation drift
 
 
@@ -85,6 +88,11 @@ def write_tum(rows, path):
             f.write("%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n" % ((stamp,) + p + q))
 
 
+def in_units(rows, unit):
+    """The trajectory with its positions in units of `unit` metres."""
+    return [(stamp, tuple(c / unit for c in p), q) for stamp, p, q in rows]
+
+
 def rows_of(name, camera, map_path, detections, groundtruth, lengths, work):
     """The frames alone, then along tracks of each length on each odometry."""
     truth = read_tum(groundtruth)
@@ -100,6 +108,14 @@ def rows_of(name, camera, map_path, detections, groundtruth, lengths, work):
         write_tum(drifting(truth, scale, deg), odometry)
         for n in lengths:
             row("%d frames" % n, label, ["--track", odometry, "--track-frames", str(n)])
+    for label, scale, deg in DRIFTS[:2]:
+        write_tum(in_units(drifting(truth, scale, deg), MONOCULAR_UNIT), odometry)
+        for n in lengths:
+            row("%d frames" % n, "monocular (%s), scale estimated" % label,
+                ["--track", odometry, "--track-frames", str(n), "--track-scale-unknown"])
+    write_tum(in_units(truth, MONOCULAR_UNIT), odometry)
+    row("%d frames" % lengths[-1], "monocular (exact), read as metric",
+        ["--track", odometry, "--track-frames", str(lengths[-1])])
 
 
 def null_rows(name, camera, map_path, frames, groundtruth, n, work):

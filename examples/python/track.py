@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """Relocalization along a track, from Python, on TUM fr2/desk: each keyframe relocalized with
 the help of the keyframes before it, their poses from an odometry (here the ground truth seen
-from a frame of its own, as a host's odometry would give it after losing the map):
+from a frame of its own, as a host's odometry would give it after losing the map; and the same
+in units of 0.37 m, as a monocular odometry, whose scale the track estimates):
 
     python3 track.py [DATA_DIR] [frames in the track]
 
 DATA_DIR holds camera.yaml, map.json, keyframes.detections.json and keyframes.groundtruth.txt
 (default: the shared tum_fr2_desk folder beside the project). Prints the Table-I rows of the
-keyframes alone and along the track, and the wrong poses each reported.
+keyframes alone and along the tracks, and the wrong poses each reported.
 """
 
 import pathlib
@@ -30,15 +31,21 @@ relocalizer = ellreloc.ObjectRelocalizer(ellreloc.read_map(data / "map.json"), c
 odometry_to_map = ellreloc.Pose(np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), [2.0, -1.0, 0.5])
 
 track = ellreloc.TrackRelocalizer(relocalizer, max_frames=length)
-rows = {"alone": [], "along the track": []}
+monocular = ellreloc.TrackRelocalizer(relocalizer, max_frames=length, metric_odometry=False)
+unit = 0.37  # metres per unit of the monocular odometry
+rows = {"alone": [], "along the track": [], "along the track of a monocular odometry": []}
 wrong = {name: 0 for name in rows}
 for frame in frames:
     k = ellreloc.find_nearest(truth, frame.timestamp)
     if k is None:  # no odometry pose: the track starts again
         track.reset()
+        monocular.reset()
         continue
-    along = track.add(frame, truth[k].pose * odometry_to_map)  # the frame's pose in the odometry
-    for name, result in (("alone", relocalizer.relocalize(frame)), ("along the track", along.result)):
+    odometry = truth[k].pose * odometry_to_map  # the frame's pose in the odometry
+    along = track.add(frame, odometry)
+    along_monocular = monocular.add(frame, ellreloc.Pose(odometry.R_cw, odometry.t_cw / unit))
+    for name, result in (("alone", relocalizer.relocalize(frame)), ("along the track", along.result),
+                         ("along the track of a monocular odometry", along_monocular.result)):
         error = ellreloc.pose_error(result.pose, truth[k].pose) if result.success else None
         rows[name].append(error)
         wrong[name] += error is not None and not error.valid
