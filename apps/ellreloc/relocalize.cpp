@@ -482,6 +482,37 @@ void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsi
   }
 }
 
+/// --camera-up, --map-up and --gravity-sigma as a prior for every frame, when both directions are given.
+std::optional<GravityPrior> gravityPrior(const RelocalizeArgs& a) {
+  if (a.camera_up.size() != 3 || a.map_up.size() != 3) return std::nullopt;
+  const GravityPrior gravity{
+      {a.camera_up[0], a.camera_up[1], a.camera_up[2]}, {a.map_up[0], a.map_up[1], a.map_up[2]}, a.gravity_sigma_deg};
+  if (!gravity.isValid())
+    throw Error("--camera-up/--map-up/--gravity-sigma: directions must be finite and non-zero, sigma positive");
+  return gravity;
+}
+
+/// Each frame's --reference pose (the nearest in time, within the reader's tolerance), if any.
+std::vector<std::optional<Pose>> referencePoses(const RelocalizeArgs& a, const std::vector<double>& timestamps) {
+  std::vector<std::optional<Pose>> references(timestamps.size());
+  if (a.reference.empty()) return references;
+  const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.reference, true);
+  for (size_t i = 0; i < timestamps.size(); ++i)
+    if (const auto k = io::findNearest(trajectory, timestamps[i])) references[i] = trajectory[*k].pose;
+  return references;
+}
+
+/// The report's `track` entry of a frame relocalized along the track.
+nlohmann::json trackReport(const TrackResult& t) {
+  return {{"frames", t.frames},
+          {"cost", t.track_cost},
+          {"evidence", t.track_evidence},
+          {"matches", t.track_matches},
+          {"candidates", t.candidates},
+          {"found_by", t.found_by},
+          {"scale", t.scale}};
+}
+
 }  // namespace
 
 int relocalize(const RelocalizeArgs& a, const Console& console) {
@@ -515,22 +546,9 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
         "the up its objects tell: (%.3f, %.3f, %.3f), t = %.1f over %d objects (--no-map-envelope: anywhere)\n",
         a.map.c_str(), relocalizer.options().envelope->max_roll_deg, up->up.x(), up->up.y(), up->up.z(), up->t,
         up->objects);
-  std::optional<GravityPrior> gravity;
-  if (a.camera_up.size() == 3 && a.map_up.size() == 3) {
-    gravity = GravityPrior{
-        {a.camera_up[0], a.camera_up[1], a.camera_up[2]}, {a.map_up[0], a.map_up[1], a.map_up[2]}, a.gravity_sigma_deg};
-    if (!gravity->isValid())
-      throw Error("--camera-up/--map-up/--gravity-sigma: directions must be finite and non-zero, sigma positive");
-  }
+  const std::optional<GravityPrior> gravity = gravityPrior(a);
   const std::vector<std::vector<Keypoint>> keypoints = frameKeypoints(a, object_map, frames);
-
-  std::vector<std::optional<Pose>> references(frames.size());
-  if (!a.reference.empty()) {
-    const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.reference, true);
-    for (size_t i = 0; i < frames.size(); ++i) {
-      if (const auto k = io::findNearest(trajectory, timestamps[i])) references[i] = trajectory[*k].pose;
-    }
-  }
+  const std::vector<std::optional<Pose>> references = referencePoses(a, timestamps);
 
   if (!a.overlays.empty()) makeOverlayFolder(a.overlays);  // inputs read and checked: fail before the work
   std::vector<std::vector<Observation>> observations(frames.size());
@@ -558,14 +576,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     if (reference) ++diagnoses[diagnosis];
     nlohmann::json j = frameReport(frames[i], r, static_cast<int>(observations[i].size()), object_map, reference,
                                    reference_scores[i], diagnosis);
-    if (const std::optional<TrackResult>& t = tracks[i])
-      j["track"] = {{"frames", t->frames},
-                    {"cost", t->track_cost},
-                    {"evidence", t->track_evidence},
-                    {"matches", t->track_matches},
-                    {"candidates", t->candidates},
-                    {"found_by", t->found_by},
-                    {"scale", t->scale}};
+    if (const std::optional<TrackResult>& t = tracks[i]) j["track"] = trackReport(*t);
     report.push_back(j);
     if (r.status == RelocalizationStatus::Success) poses.push_back({timestamps[i], r.pose, frames[i].timestampText()});
   }
