@@ -25,6 +25,8 @@ namespace {
 /// decimetres off, is itself within a few steps of the scale.
 constexpr double kScaleStep = 0.1;
 constexpr int kScaleSearchSteps = 4;
+/// Scales beyond e^+-200 (steps of 2000) are no unit of any odometry: a proposal there is clamped.
+constexpr int kMaxScaleStep = 2000;
 
 /// An odometry pose with its translation in map metres: the camera centre scaled about the
 /// odometry's origin.
@@ -62,8 +64,9 @@ struct TrackRelocalizer::Frame {
     const auto known = p.costs.find(key);
     if (known != p.costs.end()) return known->second;
     const double scale = std::exp(kScaleStep * scale_step);
-    const double cost =
-        scorer->cost(scaled(odometry, scale) * scaled(by.odometry, scale).inverse() * p.pose, kRankingIoUVertices);
+    const Pose at = scaled(odometry, scale) * scaled(by.odometry, scale).inverse() * p.pose;
+    // An absurd scale of an absurd odometry can leave no finite pose: it explains nothing.
+    const double cost = at.isValid() ? scorer->cost(at, kRankingIoUVertices) : std::numeric_limits<double>::infinity();
     p.costs.emplace(key, cost);
     return cost;
   }
@@ -131,6 +134,7 @@ std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses(const Carry
     const Pose back = (scaled(f.odometry, scale) * newest.inverse()).inverse();  // the frame's pose -> the newest's
     for (const Frame::Found& p : f.found) {
       const Pose pose = back * p.pose;
+      if (!pose.isValid()) continue;
       if (std::any_of(carried.begin(), carried.end(),
                       [&](const Carried& c) { return sameNeighbourhood(c.pose, pose); }))
         continue;
@@ -174,7 +178,8 @@ double TrackRelocalizer::proposedScale() const {
           if (distance < 0.2) continue;
           if (rotationErrorDeg(b.pose.rotation() * a.pose.rotation().transpose(), turned) > 10.0) continue;
           if ((a.pose.rotation() * map_moved / distance).dot(way) < std::cos(20.0 * M_PI / 180.0)) continue;
-          proposals.push_back({std::log(distance / baseline), baseline / widest});
+          const double log_scale = std::log(distance / baseline);
+          if (std::isfinite(log_scale)) proposals.push_back({log_scale, baseline / widest});
         }
     }
   double best_weight = 0.0, best_sum = 0.0;
@@ -194,7 +199,8 @@ TrackRelocalizer::Carrying TrackRelocalizer::chooseCarrying(std::vector<Carried>
   }
   const double proposed = proposedScale();
   const std::optional<int> centre =
-      proposed > 0.0 ? std::optional<int>(static_cast<int>(std::lround(std::log(proposed) / kScaleStep)))
+      proposed > 0.0 ? std::optional<int>(static_cast<int>(std::lround(
+                           std::clamp(std::log(proposed) / kScaleStep, -1.0 * kMaxScaleStep, 1.0 * kMaxScaleStep))))
                      : last_scale_step_;
   if (!centre) {  // no scale yet: the newest frame's poses on it alone
     const Carrying alone{0, size() - 1, false};
