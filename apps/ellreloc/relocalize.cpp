@@ -513,6 +513,22 @@ nlohmann::json trackReport(const TrackResult& t) {
           {"scale", t.scale}};
 }
 
+/// What the track's odometry gave: the frames without a pose, and the scale it was given in.
+void printTrackSummary(const RelocalizeArgs& a, const std::vector<std::optional<TrackResult>>& tracks,
+                       size_t without_odometry) {
+  std::printf("%zu frame(s) without a pose of %s within 20 ms: relocalized alone, each starting the track again\n",
+              without_odometry, a.track.c_str());
+  if (!a.track_scale_unknown) return;
+  std::vector<double> scales;
+  for (const std::optional<TrackResult>& t : tracks)
+    if (t && t->scale > 0.0) scales.push_back(t->scale);
+  if (scales.empty())
+    std::printf("no frame's track gave a scale for %s (its frames' own poses never agreed with it)\n", a.track.c_str());
+  else
+    std::printf("scale of %s: median %.4g map metres per unit over the %zu tracked frame(s) that gave one\n",
+                a.track.c_str(), median(scales), scales.size());
+}
+
 }  // namespace
 
 int relocalize(const RelocalizeArgs& a, const Console& console) {
@@ -588,9 +604,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
                 frames.size(), a.method.c_str(), median(times));
   if (without_region > 0 && !console.quiet)
     std::printf("%zu frame(s) before the first pose of %s: searched everywhere\n", without_region, a.near.c_str());
-  if (!a.track.empty() && !console.quiet)
-    std::printf("%zu frame(s) without a pose of %s within 20 ms: relocalized alone, each starting the track again\n",
-                without_odometry, a.track.c_str());
+  if (!a.track.empty() && !console.quiet) printTrackSummary(a, tracks, without_odometry);
   if (!a.reference.empty()) {  // a result: printed even when quiet
     std::printf("against %s:", a.reference.c_str());
     for (const auto& [diagnosis, count] : diagnoses) std::printf(" %s %d,", diagnosis.c_str(), count);

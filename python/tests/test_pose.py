@@ -1,6 +1,7 @@
 """Relocalization from Python: the command line's poses, threads, the refiner, bad input."""
 
 import json
+import re
 import subprocess
 import threading
 
@@ -103,10 +104,13 @@ def test_a_track_finds_the_scale_of_a_monocular_odometry(fr2, data_dir, cli, tmp
     elsewhere = E.Pose(np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), [2.0, -1.0, 0.5])
     in_units = lambda p: E.Pose(p.R_cw, p.t_cw / 0.37)
     E.write_trajectory(tmp_path / "odometry.txt", [(s.stamp, in_units(s.pose * elsewhere)) for s in truth])
-    subprocess.run([cli, "relocalize", "--camera", str(d / "camera.yaml"), "--map", str(d / "map.json"),
-                    "--detections", str(d / "keyframes.detections.json"), "--track", str(tmp_path / "odometry.txt"),
-                    "--track-frames", "5", "--track-scale-unknown", "--out", str(tmp_path / "cli.txt"),
-                    "--report", str(tmp_path / "report.json")], check=True, capture_output=True)
+    printed = subprocess.run([cli, "relocalize", "--camera", str(d / "camera.yaml"), "--map", str(d / "map.json"),
+                              "--detections", str(d / "keyframes.detections.json"), "--track",
+                              str(tmp_path / "odometry.txt"), "--track-frames", "5", "--track-scale-unknown", "--out",
+                              str(tmp_path / "cli.txt"), "--report", str(tmp_path / "report.json")],
+                             check=True, capture_output=True, text=True).stdout
+    said = re.search(r"median ([0-9.]+) map metres per unit over the (\d+) tracked frame", printed)
+    assert said and abs(float(said.group(1)) / 0.37 - 1) < 0.05, printed
     relocalizer = E.ObjectRelocalizer(map_, camera)
     track = E.TrackRelocalizer(relocalizer, max_frames=5, metric_odometry=False)
     odometry = E.read_trajectory(tmp_path / "odometry.txt")
