@@ -523,7 +523,9 @@ void printTrackSummary(const RelocalizeArgs& a, const std::vector<std::optional<
   for (const std::optional<TrackResult>& t : tracks)
     if (t && t->scale > 0.0) scales.push_back(t->scale);
   if (scales.empty())
-    std::printf("no frame's track gave a scale for %s (its frames' own poses never agreed with it)\n", a.track.c_str());
+    std::printf(
+        "no scale found for %s: no two frames of a track had poses of their own that turned and moved as it does\n",
+        a.track.c_str());
   else
     std::printf("scale of %s: median %.4g map metres per unit over the %zu tracked frame(s) that gave one\n",
                 a.track.c_str(), median(scales), scales.size());
