@@ -182,11 +182,17 @@ double TrackRelocalizer::proposedScale() const {
           if (std::isfinite(log_scale)) proposals.push_back({log_scale, baseline / widest});
         }
     }
-  double best_weight = 0.0, best_sum = 0.0;
+  // The cluster of each proposal: those within 0.1 of it in log scale, found in sorted order (a
+  // long track of many poses has thousands of proposals).
+  std::sort(proposals.begin(), proposals.end(),
+            [](const Proposal& a, const Proposal& b) { return a.log_scale < b.log_scale; });
+  double best_weight = 0.0, best_sum = 0.0, weight = 0.0, sum = 0.0;
+  size_t lo = 0, hi = 0;  // the cluster of proposal i: [lo, hi)
   for (const Proposal& p : proposals) {
-    double weight = 0.0, sum = 0.0;
-    for (const Proposal& q : proposals)
-      if (std::abs(q.log_scale - p.log_scale) < 0.1) weight += q.weight, sum += q.weight * q.log_scale;
+    for (; hi < proposals.size() && proposals[hi].log_scale - p.log_scale < 0.1; ++hi)
+      weight += proposals[hi].weight, sum += proposals[hi].weight * proposals[hi].log_scale;
+    for (; p.log_scale - proposals[lo].log_scale >= 0.1; ++lo)
+      weight -= proposals[lo].weight, sum -= proposals[lo].weight * proposals[lo].log_scale;
     if (weight > best_weight) best_weight = weight, best_sum = sum;
   }
   return best_weight > 0.0 ? std::exp(best_sum / best_weight) : 0.0;
