@@ -29,14 +29,6 @@ struct TrackOptions {
   /// poses further on the odometry's drift; a frame's work grows with it (its poses are scored
   /// on every frame, every kept pose on it), and the memory with its square. At most 100.
   int max_frames = 10;
-  /// The odometry is metric (visual-inertial, stereo or RGB-D odometry, wheels). A monocular
-  /// host's odometry (the new map a monocular SLAM system starts after a loss) has a scale of its
-  /// own, unknown and drifting: false, and the track estimates the map's metres per odometry
-  /// unit at each frame. Pairs of frames whose own poses turn and move as the odometry does
-  /// propose a scale; the scale, within a factor 1.5 of theirs, at which the track's best pose
-  /// costs least is taken (TrackResult::scale). Until a first proposal, the newest frame's own
-  /// poses are ranked on it alone.
-  bool metric_odometry = true;
   /// With the relocalizer's acceptance test on (acceptance.enabled), a pose is Success only when
   /// the track's frames' evidence at it sums to acceptance.min_evidence and averages at least
   /// `min_mean_evidence` per frame (a look-alike pose explains a few of each frame's
@@ -46,6 +38,14 @@ struct TrackOptions {
   /// alone on any of them, and more right ones (docs/benchmarks.md, "Over a track").
   double min_mean_evidence = 1.5;
   double min_margin = 0.5;
+  /// The odometry is metric (visual-inertial, stereo or RGB-D odometry, wheels). A monocular
+  /// host's odometry (the new map a monocular SLAM system starts after a loss) has a scale of its
+  /// own, unknown and drifting: false, and the track estimates the map's metres per odometry
+  /// unit at each frame. Pairs of frames whose own poses turn and move as the odometry does
+  /// propose a scale; the scale, within a factor 1.5 of theirs, at which the track's best pose
+  /// costs least is taken (TrackResult::scale). Until a first proposal, the newest frame's own
+  /// poses are ranked on it alone.
+  bool metric_odometry = true;
   /// Why the options are unusable, or empty.
   std::string validate() const;
 };
