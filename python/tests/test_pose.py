@@ -17,6 +17,13 @@ def python_trajectory(path, frames, results):
     return path.read_bytes()
 
 
+def valid_and_wrong(frames, results, truth):
+    """The successful results valid (30 cm, 30 deg) against the nearest true pose, and the others."""
+    right = [E.pose_error(r.pose, truth[E.find_nearest(truth, f.timestamp)].pose).valid
+             for f, r in zip(frames, results) if r.success]
+    return sum(right), len(right) - sum(right)
+
+
 @pytest.mark.parametrize("method", ["ours", "oa-slam"])
 def test_fr2_keyframes_give_exactly_the_command_line_poses(fr2, data_dir, cli, tmp_path, method):
     camera, map_, frames = fr2
@@ -80,12 +87,9 @@ def test_a_track_gives_the_command_lines_track_poses(fr2, data_dir, cli, tmp_pat
     assert [t.frames for t in tracked[:5]] == [1, 2, 3, 4, 4] and len(track) == 4
     assert python_trajectory(tmp_path / "python.txt", frames, [t.result for t in tracked]) == \
         (tmp_path / "cli.txt").read_bytes()
-    alone = [relocalizer.relocalize(f) for f in frames]
-    right = lambda f, r: E.pose_error(r.pose, truth[E.find_nearest(truth, f.timestamp)].pose).valid
-    valid = lambda results: sum(r.success and right(f, r) for f, r in zip(frames, results))
-    wrong = lambda results: sum(r.success and not right(f, r) for f, r in zip(frames, results))
-    along = [t.result for t in tracked]
-    assert valid(along) >= valid(alone) + 15 and wrong(along) <= wrong(alone)  # measured: 144 and 122 right, 1 and 14 wrong
+    valid, wrong = valid_and_wrong(frames, [t.result for t in tracked], truth)
+    valid_alone, wrong_alone = valid_and_wrong(frames, [relocalizer.relocalize(f) for f in frames], truth)
+    assert valid >= valid_alone + 15 and wrong <= wrong_alone  # measured: 144 and 122 right, 1 and 14 wrong
     assert all(isinstance(t, E.TrackResult) for t in tracked)
     assert all(t.found_by >= 0 and t.track_evidence >= t.result.score - 1e-9 for t in tracked if t.result.success)
     track.reset()
@@ -122,12 +126,9 @@ def test_a_track_finds_the_scale_of_a_monocular_odometry(fr2, data_dir, cli, tmp
     assert tracked[0].scale == 0.0 and tracked[0].frames == 1  # nothing to propose a scale yet
     scales = [t.scale for t in tracked if t.scale > 0]
     assert len(scales) > 180 and abs(np.log(np.median(scales) / 0.37)) < 0.05  # measured: 195 frames, median 0.376
-    alone = [relocalizer.relocalize(f) for f in frames]
-    right = lambda f, r: E.pose_error(r.pose, truth[E.find_nearest(truth, f.timestamp)].pose).valid
-    valid = lambda results: sum(r.success and right(f, r) for f, r in zip(frames, results))
-    wrong = lambda results: sum(r.success and not right(f, r) for f, r in zip(frames, results))
-    along = [t.result for t in tracked]
-    assert valid(along) >= valid(alone) + 15 and wrong(along) <= wrong(alone)  # measured: 143 and 122 right, 0 and 14 wrong
+    valid, wrong = valid_and_wrong(frames, [t.result for t in tracked], truth)
+    valid_alone, wrong_alone = valid_and_wrong(frames, [relocalizer.relocalize(f) for f in frames], truth)
+    assert valid >= valid_alone + 15 and wrong <= wrong_alone  # measured: 143 and 122 right, 0 and 14 wrong
 
 
 def test_relocalize_frames_on_threads_equals_one_by_one(fr2):
