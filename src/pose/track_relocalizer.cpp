@@ -32,6 +32,15 @@ constexpr int kMaxScaleStep = 2000;
 /// odometry's origin.
 Pose scaled(const Pose& odometry, double scale) { return Pose(odometry.rotation(), scale * odometry.translation()); }
 
+/// Map metres per odometry unit at a scale step.
+double scaleAt(int scale_step) { return std::exp(kScaleStep * scale_step); }
+
+/// The pose of the frame at odometry pose `on` given the pose `pose` of the frame at odometry pose
+/// `by` (world -> camera): x_on = O_on O_by^-1 x_by, the odometry's translations times `scale`.
+Pose carriedPose(const Pose& on, const Pose& by, double scale, const Pose& pose) {
+  return scaled(on, scale) * scaled(by, scale).inverse() * pose;
+}
+
 }  // namespace
 
 std::string TrackOptions::validate() const {
@@ -63,8 +72,7 @@ struct TrackRelocalizer::Frame {
         (static_cast<std::uint64_t>(serial) << 20) ^ static_cast<std::uint64_t>(scale_step + (1 << 19));
     const auto known = p.costs.find(key);
     if (known != p.costs.end()) return known->second;
-    const double scale = std::exp(kScaleStep * scale_step);
-    const Pose at = scaled(odometry, scale) * scaled(by.odometry, scale).inverse() * p.pose;
+    const Pose at = carriedPose(odometry, by.odometry, scaleAt(scale_step), p.pose);
     // An absurd scale of an absurd odometry can leave no finite pose: it explains nothing.
     const double cost = at.isValid() ? scorer->cost(at, kRankingIoUVertices) : std::numeric_limits<double>::infinity();
     p.costs.emplace(key, cost);
@@ -72,7 +80,7 @@ struct TrackRelocalizer::Frame {
   }
 };
 
-double TrackRelocalizer::Carrying::scale() const { return std::exp(kScaleStep * scale_step); }
+double TrackRelocalizer::Carrying::scale() const { return scaleAt(scale_step); }
 
 TrackRelocalizer::TrackRelocalizer(const ObjectRelocalizer& relocalizer, TrackOptions options)
     : relocalizer_(relocalizer), options_(options) {}
@@ -88,13 +96,11 @@ TrackRelocalizer::TrackScore TrackRelocalizer::score(const Pose& pose, bool with
                                                      const Carrying& carrying) const {
   TrackScore s;
   const double scale = carrying.scale();
-  const Pose newest = scaled(frames_.back()->odometry, scale);
   const int vertices = with_evidence ? kReportIoUVertices : kRankingIoUVertices;
   std::vector<ObjectCorrespondence> matches;
   for (size_t k = static_cast<size_t>(carrying.first); k < frames_.size(); ++k) {
     const Frame* frame = frames_[k].get();
-    // x_frame = odometry_frame odometry_newest^-1 x_newest, so the frame's pose is that times `pose`.
-    const Pose at = scaled(frame->odometry, scale) * newest.inverse() * pose;
+    const Pose at = carriedPose(frame->odometry, frames_.back()->odometry, scale, pose);
     s.cost += frame->scorer->cost(at, vertices, with_evidence ? &matches : nullptr);
     if (with_evidence) {
       s.evidence += matchEvidence(matches, frame->candidates.num_usable, relocalizer_.options().acceptance);

@@ -68,7 +68,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       FUZZ_CHECK(odometry.isValid() ||
                  (t.result.status == RelocalizationStatus::InvalidInput && track.size() == before));
       FUZZ_CHECK(track.size() <= track_options.max_frames);
-      FUZZ_CHECK(std::isfinite(t.scale) && t.scale >= 0.0 && (track_options.metric_odometry ? t.scale == 1.0 : true));
+      FUZZ_CHECK(std::isfinite(t.scale) && t.scale >= 0.0 && (!track_options.metric_odometry || t.scale == 1.0));
     }
   }
   return 0;
