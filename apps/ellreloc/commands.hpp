@@ -96,6 +96,9 @@ struct RelocalizeArgs {
   int track_frames = TrackOptions().max_frames;
   /// The --track odometry's scale is unknown (a monocular host's): the track estimates it.
   bool track_scale_unknown = false;
+  /// The detections (and keypoints) were made on the raw images of the --camera file's
+  /// distorted lens: undistort them (ObserveOptions::lens).
+  bool undistort = false;
 };
 /// `use_points` is set after parsing, from whether --points was given.
 CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a);

@@ -146,6 +146,9 @@ CLI::App* addRelocalizeCommand(CLI::App& app, RelocalizeArgs& a) {
                     "more (ours; 0.1-0.3 drop many wrong poses and a few valid ones: docs/reliability.md)")
           ->capture_default_str()
           ->check(CLI::Range(0.0, 1e6));
+  r->add_flag("--undistort", a.undistort,
+              "the detections were made on raw images of a distorted lens: undistort their boxes, ellipses and "
+              "keypoints with the --camera file's Camera.k1, k2, p1, p2, k3 (left out: 0) before relocalizing");
   r->add_flag("--accept-all", a.accept_all,
               "report every pose found, however weakly supported (as the oa-slam method does)")
       ->excludes(min_margin);
@@ -449,8 +452,8 @@ void makeOverlayFolder(const std::string& dir) {
 /// makeOverlayFolder.
 void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsics& K,
                    const std::vector<DetectionFrame>& frames, const std::vector<std::vector<Observation>>& observations,
-                   const std::vector<RelocalizationResult>& results,
-                   const std::vector<std::optional<Pose>>& references) {
+                   const std::vector<RelocalizationResult>& results, const std::vector<std::optional<Pose>>& references,
+                   const Lens* lens) {
   namespace fs = std::filesystem;
   const fs::path images = fs::path(a.detections).parent_path();
   for (size_t i = 0; i < frames.size(); ++i) {
@@ -478,7 +481,7 @@ void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsi
     std::error_code exists_ec;
     const bool found = !frames[i].file_name.empty() && fs::is_regular_file(image, exists_ec);
     io::writeOverlay((fs::path(a.overlays) / (frames[i].timestampText() + ".png")).string(), K, map, c,
-                     found ? image.string() : "");
+                     found ? image.string() : "", lens);
   }
 }
 
@@ -557,6 +560,12 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const std::vector<std::optional<Pose>> odometry = trackPoses(a, timestamps, &without_odometry);
   ObserveOptions observe_options;
   observe_options.policy = parsePolicy(policy.empty() ? "solid" : policy);
+  if (a.undistort) {
+    observe_options.lens = io::readLens(a.camera);
+    if (observe_options.lens->distortion.isZero() && !console.quiet)
+      std::printf("%s: no distortion (Camera.k1 ... all 0 or left out): --undistort changes nothing\n",
+                  a.camera.c_str());
+  }
   const ObjectRelocalizer relocalizer(object_map, K, options);
   if (const auto& up = relocalizer.upFromObjects(); up && !console.quiet)
     std::printf(
@@ -565,7 +574,13 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
         a.map.c_str(), relocalizer.options().envelope->max_roll_deg, up->up.x(), up->up.y(), up->up.z(), up->t,
         up->objects);
   const std::optional<GravityPrior> gravity = gravityPrior(a);
-  const std::vector<std::vector<Keypoint>> keypoints = frameKeypoints(a, object_map, frames);
+  std::vector<std::vector<Keypoint>> keypoints = frameKeypoints(a, object_map, frames);
+  if (size_t left_out = 0; observe_options.lens) {
+    for (std::vector<Keypoint>& k : keypoints) k = undistortKeypoints(*observe_options.lens, k, &left_out);
+    if (left_out > 0)
+      std::fprintf(stderr, "warning: %zu keypoint(s) left out: beyond where the lens's distortion can be undone\n",
+                   left_out);
+  }
   const std::vector<std::optional<Pose>> references = referencePoses(a, timestamps);
 
   if (!a.overlays.empty()) makeOverlayFolder(a.overlays);  // inputs read and checked: fail before the work
@@ -599,7 +614,9 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     if (r.status == RelocalizationStatus::Success) poses.push_back({timestamps[i], r.pose, frames[i].timestampText()});
   }
   io::writeTumTrajectory(a.out, poses);
-  if (!a.overlays.empty()) writeOverlays(a, object_map, K, frames, observations, results, references);
+  if (!a.overlays.empty())
+    writeOverlays(a, object_map, K, frames, observations, results, references,
+                  observe_options.lens ? &*observe_options.lens : nullptr);
   if (!a.report.empty()) io::writeFileAtomically(a.report, report.dump(1) + "\n");
   if (!console.quiet)
     std::printf("wrote %s: %zu of %zu frames relocalized (%s), median %.1f ms per frame\n", a.out.c_str(), poses.size(),

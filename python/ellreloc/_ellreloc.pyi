@@ -83,6 +83,17 @@ class DetectionFrame:
     timestamp: Optional[float]
 
 
+class Distortion:
+    """Radial-tangential lens distortion (OpenCV's and ORB-SLAM's k1, k2, p1, p2, k3)."""
+    def __init__(self, k1: float = ..., k2: float = ..., p1: float = ..., p2: float = ..., k3: float = ...) -> None: ...
+    k1: float
+    k2: float
+    p1: float
+    p2: float
+    k3: float
+    def is_zero(self) -> bool: ...
+
+
 class Ellipse:
     """An image ellipse: centre (px), semi-axes (px, major first) and the angle (rad) of the first axis from the image x axis. Its Gaussian covariance is R diag(a^2, b^2) R^T."""
     def __init__(self, center: ArrayLike, axes: ArrayLike, angle: float = ...) -> None: ...
@@ -228,6 +239,17 @@ class Keypoint:
     uv: numpy.ndarray
 
 
+class Lens:
+    """A raw image's camera: pinhole intrinsics and the distortion of its lens. Detections made on the raw image are moved to the pinhole image of the same intrinsics (ObserveOptions.lens)."""
+    def __init__(self, intrinsics: Intrinsics, distortion: Distortion) -> None: ...
+    intrinsics: Intrinsics
+    distortion: Distortion
+    def undistort_pixel(self, uv: ArrayLike) -> object: """The pinhole pixel of a raw pixel; None where the model cannot be undone."""
+    def distort_pixel(self, uv: ArrayLike) -> numpy.ndarray: """The raw pixel where the pinhole image's pixel was taken."""
+    def undistort_box(self, box: Box | ArrayLike) -> Optional[Box]: """The bounding box of the raw box's outline once undistorted; None where it cannot be."""
+    def undistort_ellipse(self, ellipse: Ellipse) -> Optional[Ellipse]: """The ellipse of the raw ellipse's outline once undistorted; None where it cannot be."""
+
+
 class MapObject:
     """A mapped object: id, category (COCO-80, 0-based), label and ellipsoid."""
     def __init__(self, id: int, category: int, ellipsoid: Ellipsoid, label: str = ..., category_counts: dict[int, float] = ...) -> None: ...
@@ -328,8 +350,8 @@ class ObjectMap:
 
 
 class ObjectRelocalizer:
-    """Relocalizes query frames against a map of ellipsoids. Keyword groups set options: ObjectRelocalizer(map, camera, scoring={'min_overlap': 0.2}, acceptance={'enabled': False}). method='oa-slam' gives OA-SLAM's exhaustive baseline (with the 'bbox' policy)."""
-    def __init__(self, map: ObjectMap, camera: Intrinsics, options: Optional[RelocalizerOptions] = ..., method: str = ..., policy: str | ObservationPolicy | None = ..., **groups: dict[str, Any] | CameraEnvelope | None) -> None: ...
+    """Relocalizes query frames against a map of ellipsoids. Keyword groups set options: ObjectRelocalizer(map, camera, scoring={'min_overlap': 0.2}, acceptance={'enabled': False}). method='oa-slam' gives OA-SLAM's exhaustive baseline (with the 'bbox' policy). lens=read_lens(path): the frames' detections and keypoints are of the raw images of that distorted lens."""
+    def __init__(self, map: ObjectMap, camera: Intrinsics, options: Optional[RelocalizerOptions] = ..., method: str = ..., policy: str | ObservationPolicy | None = ..., lens: Optional[Lens] = ..., **groups: dict[str, Any] | CameraEnvelope | None) -> None: ...
     def relocalize(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection], keypoints: Sequence[Keypoint] | ArrayLike | None = ..., gravity: Optional[GravityPrior] = ..., region: Optional[PoseRegion] = ...) -> RelocalizationResult: """Relocalizes one frame: a DetectionFrame (observed with this relocalizer's policy, its keypoints used unless `keypoints` is given), a list of Detection or a list of Observation. `keypoints`: Keypoint items or an (n, 3) array of (point_index, u, v); `gravity`: a GravityPrior; `region`: a PoseRegion (poses outside it are never hypotheses). The GIL is released meanwhile."""
     def relocalize_frames(self, frames: list[DetectionFrame], threads: int = ..., regions: Optional[list[Optional[PoseRegion]]] = ...) -> list[RelocalizationResult]: """Relocalizes many DetectionFrames in C++ on `threads` threads; the same results as relocalize() on each (with `regions`, one PoseRegion or None per frame, as its `region`)."""
     def observe(self, frame: DetectionFrame | Sequence[Observation] | Sequence[Detection]) -> list[Observation]: """The observations relocalize() makes of a frame."""
@@ -340,6 +362,7 @@ class ObjectRelocalizer:
     camera: Intrinsics
     options: RelocalizerOptions
     policy: ObservationPolicy
+    lens: Optional[Lens]
     method: str
     left_out: list[str]
     up_from_objects: Optional[dict[str, Any]]
@@ -379,6 +402,7 @@ class ObserveOptions:
     regular: RegularMaskOptions
     border_px: float
     solid_min_solidity: float
+    lens: Optional[Lens]
     def validate(self) -> str: """'' when every threshold is in range, else the first that is not."""
 
 
@@ -760,6 +784,10 @@ def read_camera(path: str | os.PathLike[str]) -> Intrinsics: """Intrinsics from 
 def read_depth_png(path: str | os.PathLike[str], units_per_metre: float = ...) -> numpy.ndarray: """A 16-bit depth PNG as a (height, width) float32 array in metres (0 = no reading)."""
 
 def read_detections(path: str | os.PathLike[str]) -> list[DetectionFrame]: """A detections file as a list of DetectionFrame."""
+
+def read_distortion(path: str | os.PathLike[str]) -> Distortion: """The lens distortion of a camera file (Camera.k1 ... or "k1" ...; 0 where left out)."""
+
+def read_lens(path: str | os.PathLike[str]) -> Lens: """Intrinsics and distortion of a camera file, for detections made on its raw images (ObserveOptions.lens)."""
 
 def read_map(path: str | os.PathLike[str]) -> ObjectMap: """A JSON or OA-SLAM text map. Objects that cannot be used are left out with a UserWarning naming them."""
 

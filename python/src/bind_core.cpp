@@ -12,6 +12,7 @@
 #include "ellreloc/core/box.hpp"
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/distortion.hpp"
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/ellipsoid.hpp"
 #include "ellreloc/core/evaluation.hpp"
@@ -193,6 +194,52 @@ void bindEllipsoidAndCamera(py::module_& m) {
                       }));
 }
 
+void bindLens(py::module_& m) {
+  py::class_<Distortion>(m, "Distortion",
+                         "Radial-tangential lens distortion (OpenCV's and ORB-SLAM's k1, k2, p1, p2, k3).")
+      .def(py::init([](double k1, double k2, double p1, double p2, double k3) {
+             return Distortion{k1, k2, p1, p2, k3};
+           }),
+           py::arg("k1") = 0.0, py::arg("k2") = 0.0, py::arg("p1") = 0.0, py::arg("p2") = 0.0, py::arg("k3") = 0.0)
+      .def_readwrite("k1", &Distortion::k1)
+      .def_readwrite("k2", &Distortion::k2)
+      .def_readwrite("p1", &Distortion::p1)
+      .def_readwrite("p2", &Distortion::p2)
+      .def_readwrite("k3", &Distortion::k3)
+      .def("is_zero", &Distortion::isZero)
+      .def("__repr__", [](const Distortion& d) {
+        return format("Distortion(k1=%g, k2=%g, p1=%g, p2=%g, k3=%g)", d.k1, d.k2, d.p1, d.p2, d.k3);
+      });
+  py::class_<Lens>(m, "Lens",
+                   "A raw image's camera: pinhole intrinsics and the distortion of its lens. Detections made on "
+                   "the raw image are moved to the pinhole image of the same intrinsics (ObserveOptions.lens).")
+      .def(py::init([](const Intrinsics& K, const Distortion& d) {
+             const Lens lens{K, d};
+             if (const std::string why = lens.whyNotUsable(); !why.empty()) badArgument("distortion", why);
+             return lens;
+           }),
+           py::arg("intrinsics"), py::arg("distortion"))
+      .def_readonly("intrinsics", &Lens::intrinsics)
+      .def_readonly("distortion", &Lens::distortion)
+      .def(
+          "undistort_pixel",
+          [](const Lens& lens, const py::handle& uv) -> py::object {
+            const std::optional<Eigen::Vector2d> p = lens.undistortPixel(vector<2>(uv, "uv"));
+            return p ? py::object(toArray(*p)) : py::none();
+          },
+          py::arg("uv"), "The pinhole pixel of a raw pixel; None where the model cannot be undone.")
+      .def(
+          "distort_pixel",
+          [](const Lens& lens, const py::handle& uv) {
+            return toArray(lens.distortion.distortPixel(lens.intrinsics, vector<2>(uv, "uv")));
+          },
+          py::arg("uv"), "The raw pixel where the pinhole image's pixel was taken.")
+      .def("undistort_box", &Lens::undistortBox, py::arg("box"),
+           "The bounding box of the raw box's outline once undistorted; None where it cannot be.")
+      .def("undistort_ellipse", &Lens::undistortEllipse, py::arg("ellipse"),
+           "The ellipse of the raw ellipse's outline once undistorted; None where it cannot be.");
+}
+
 void bindPoseClass(py::module_& m) {
   py::class_<Pose>(m, "Pose",
                    "A camera pose, stored world->camera: x_c = R_cw x_w + t_cw. T_wc is the camera->world "
@@ -342,6 +389,7 @@ Box boxFrom(const py::handle& h, const std::string& name) {
 void bindCore(py::module_& m) {
   bindBoxAndEllipse(m);
   bindEllipsoidAndCamera(m);
+  bindLens(m);
   bindPoseClass(m);
   bindGeometryFunctions(m);
   bindEvaluation(m);

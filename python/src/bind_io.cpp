@@ -73,6 +73,12 @@ void bindFiles(py::module_& m) {
       "read_camera", [](const py::handle& path) { return io::readCamera(pathFrom(path)); }, py::arg("path"),
       "Intrinsics from ORB-SLAM YAML or JSON.");
   m.def(
+      "read_distortion", [](const py::handle& path) { return io::readDistortion(pathFrom(path)); }, py::arg("path"),
+      "The lens distortion of a camera file (Camera.k1 ... or \"k1\" ...; 0 where left out).");
+  m.def(
+      "read_lens", [](const py::handle& path) { return io::readLens(pathFrom(path)); }, py::arg("path"),
+      "Intrinsics and distortion of a camera file, for detections made on its raw images (ObserveOptions.lens).");
+  m.def(
       "write_camera", [](const py::handle& path, const Intrinsics& K) { io::writeCamera(pathFrom(path), K); },
       py::arg("path"), py::arg("camera"), "JSON for a .json path, ORB-SLAM YAML otherwise.");
   m.def(

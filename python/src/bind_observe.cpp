@@ -63,6 +63,9 @@ void bindOptions(py::module_& m) {
           "solid_min_solidity", &ObserveOptions::solid_min_solidity,
           "policy 'solid': a mask the quadrilateral test turns down gets the hull fit when it covers at least "
           "this share of its convex hull")
+      .def_readwrite("lens", &ObserveOptions::lens,
+                     "the Lens of the raw images the detections were made on: each observation is moved to the "
+                     "pinhole image; None: the detections are taken as pinhole")
       .def("validate", &ObserveOptions::validate, "'' when every threshold is in range, else the first that is not.");
 }
 

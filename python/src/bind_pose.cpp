@@ -31,6 +31,10 @@ struct Relocalizer {
     const Intrinsics& K = relocalizer.intrinsics();
     return observeDetections(frame.detections, K.width, K.height, observe);
   }
+  /// Keypoints of the raw image in the pinhole image when the frames come through a lens.
+  std::vector<Keypoint> keypoints(const std::vector<Keypoint>& raw) const {
+    return observe.lens ? undistortKeypoints(*observe.lens, raw) : raw;
+  }
 };
 
 /// Sets the fields of one option group from a dict: {"min_overlap": 0.2} on options.scoring.
@@ -46,7 +50,8 @@ void setGroup(py::object group, const std::string& group_name, const py::handle&
 }
 
 Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optional<RelocalizerOptions>& given,
-                            const std::string& method, const py::handle& policy, const py::kwargs& groups) {
+                            const std::string& method, const py::handle& policy, const std::optional<Lens>& lens,
+                            const py::kwargs& groups) {
   if (method != "ours" && method != "oa-slam")
     badArgument("method", "expected 'ours' or 'oa-slam', got '" + method + "'");
   if (given && method == "oa-slam") badArgument("method", "give either options or method='oa-slam', not both");
@@ -72,6 +77,12 @@ Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optio
   ObserveOptions observe;
   observe.policy = method == "oa-slam" ? ObservationPolicy::Bbox : ObservationPolicy::Solid;
   if (!policy.is_none()) observe.policy = policyFrom(policy);
+  if (lens) {
+    const Intrinsics& L = lens->intrinsics;
+    if (L.fx != K.fx || L.fy != K.fy || L.cx != K.cx || L.cy != K.cy || L.width != K.width || L.height != K.height)
+      badArgument("lens", "its intrinsics are not the camera's");
+    observe.lens = lens;
+  }
   return Relocalizer{ObjectRelocalizer(std::move(map), K, options), observe, method};
 }
 
@@ -80,7 +91,7 @@ Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optio
 std::vector<Observation> observationsFrom(const Relocalizer& r, const py::handle& h, std::vector<Keypoint>* keypoints) {
   if (py::isinstance<DetectionFrame>(h)) {
     const auto& frame = h.cast<const DetectionFrame&>();
-    if (keypoints) *keypoints = frame.keypoints;
+    if (keypoints) *keypoints = r.keypoints(frame.keypoints);
     return r.observations(frame);
   }
   if (py::isinstance<py::str>(h) || !py::hasattr(h, "__iter__"))
@@ -104,7 +115,7 @@ RelocalizationResult relocalizeOne(const Relocalizer& r, const py::handle& frame
                                    const std::optional<PoseRegion>& region) {
   std::vector<Keypoint> points;
   const std::vector<Observation> observations = observationsFrom(r, frame, &points);
-  if (!keypoints.is_none()) points = keypointsFrom(keypoints);
+  if (!keypoints.is_none()) points = r.keypoints(keypointsFrom(keypoints));
   py::gil_scoped_release release;
   return r.relocalizer.relocalize(observations, points, gravity, region);
 }
@@ -124,7 +135,7 @@ std::vector<RelocalizationResult> relocalizeMany(const Relocalizer& r, const std
   const auto work = [&] {
     try {
       for (size_t i = next++; i < frames.size(); i = next++)
-        results[i] = r.relocalizer.relocalize(r.observations(frames[i]), frames[i].keypoints, std::nullopt,
+        results[i] = r.relocalizer.relocalize(r.observations(frames[i]), r.keypoints(frames[i].keypoints), std::nullopt,
                                               regions ? (*regions)[i] : std::nullopt);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(failure_mutex);
@@ -417,9 +428,10 @@ void bindRelocalizer(py::module_& m) {
       m, "ObjectRelocalizer",
       "Relocalizes query frames against a map of ellipsoids. Keyword groups set options: "
       "ObjectRelocalizer(map, camera, scoring={'min_overlap': 0.2}, acceptance={'enabled': False}). "
-      "method='oa-slam' gives OA-SLAM's exhaustive baseline (with the 'bbox' policy).")
+      "method='oa-slam' gives OA-SLAM's exhaustive baseline (with the 'bbox' policy). lens=read_lens(path): "
+      "the frames' detections and keypoints are of the raw images of that distorted lens.")
       .def(py::init(&makeRelocalizer), py::arg("map"), py::arg("camera"), py::arg("options") = py::none(),
-           py::arg("method") = "ours", py::arg("policy") = py::none())
+           py::arg("method") = "ours", py::arg("policy") = py::none(), py::arg("lens") = py::none())
       .def("relocalize", &relocalizeOne, py::arg("frame"), py::arg("keypoints") = py::none(),
            py::arg("gravity") = py::none(), py::arg("region") = py::none(),
            "Relocalizes one frame: a DetectionFrame (observed with this relocalizer's policy, its keypoints used "
@@ -463,6 +475,7 @@ void bindRelocalizer(py::module_& m) {
       .def_property_readonly(
           "options", [](const Relocalizer& r) { return r.relocalizer.options(); }, "A copy.")
       .def_property_readonly("policy", [](const Relocalizer& r) { return r.observe.policy; })
+      .def_property_readonly("lens", [](const Relocalizer& r) { return r.observe.lens; })
       .def_property_readonly("method", [](const Relocalizer& r) { return r.method; })
       .def_property_readonly(
           "left_out", [](const Relocalizer& r) { return r.relocalizer.leftOut(); },

@@ -120,6 +120,30 @@ def test_box_observations_and_policies():
         E.observe(d, 640, 480, options=options)
 
 
+def test_a_lens_moves_observations_to_the_pinhole_image(data_dir):
+    lens = E.read_lens(data_dir / "tum_fr2_desk" / "camera.yaml")
+    raw_box = E.Box(20, 30, 140, 120)
+    pinhole = lens.undistort_box(raw_box)
+    assert pinhole.x1 > raw_box.x1 + 3 and pinhole.y1 > raw_box.y1 + 3  # fr2's lens pulls the corner inwards
+    corner = lens.undistort_pixel([0.0, 0.0])
+    assert np.allclose(lens.distort_pixel(corner), [0.0, 0.0], atol=1e-6)
+    options = E.ObserveOptions()
+    options.lens = lens
+    r = E.observe(E.Detection(62, raw_box), 640, 480, policy="bbox", options=options)
+    assert r.observation.box.x1 == pytest.approx(pinhole.x1) and r.observation.box.y2 == pytest.approx(pinhole.y2)
+    assert np.allclose(r.observation.ellipse.center, [(pinhole.x1 + pinhole.x2) / 2, (pinhole.y1 + pinhole.y2) / 2])
+    assert E.observe(E.Detection(62, raw_box), 320, 240, options=options).status == E.ObserveStatus.invalid_options
+    with pytest.raises(ValueError, match="distortion: the radial distortion folds over"):
+        E.Lens(lens.intrinsics, E.Distortion(k1=-0.9))
+    # An ellipse is moved as its outline is; a lens without distortion moves nothing.
+    raw = E.Ellipse([80, 70], [60, 25], 0.3)
+    moved = lens.undistort_ellipse(raw)
+    assert np.linalg.norm(moved.center - raw.center) > 3
+    flat = E.Lens(lens.intrinsics, E.read_distortion(data_dir / "tum_fr3_cabinet" / "camera.yaml"))
+    assert flat.distortion.is_zero()
+    assert np.allclose(flat.undistort_ellipse(raw).center, raw.center) and flat.undistort_box(raw_box).x1 == 20
+
+
 def test_real_masks_observe_as_from_the_file(data_dir):
     d = data_dir / "labelme_masks"
     frames = E.read_detections(d / "detections.json")

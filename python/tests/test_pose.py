@@ -38,6 +38,36 @@ def test_fr2_keyframes_give_exactly_the_command_line_poses(fr2, data_dir, cli, t
     assert ours.count(b"\n") > 90  # most keyframes relocalize
 
 
+def test_a_lens_undistorts_as_the_command_line_does(fr2, data_dir, cli, tmp_path):
+    """fr2's raw Kinect images through its lens: `relocalize --undistort` and a relocalizer given
+    the camera file's lens give the same poses, which lie closer to the keyframes' than the raw
+    boxes' (median over the frames valid both ways)."""
+    camera, map_, frames = fr2
+    d = data_dir / "tum_fr2_desk"
+    subprocess.run([cli, "relocalize", "--camera", str(d / "camera.yaml"), "--map", str(d / "map.json"),
+                    "--detections", str(d / "keyframes.detections.json"), "--undistort",
+                    "--out", str(tmp_path / "cli.txt")], check=True, capture_output=True)
+    lens = E.read_lens(d / "camera.yaml")
+    assert lens.distortion.k1 == pytest.approx(0.231222)
+    undistorted = E.ObjectRelocalizer(map_, camera, lens=lens)
+    results = [undistorted.relocalize(f) for f in frames]
+    assert python_trajectory(tmp_path / "python.txt", frames, results) == (tmp_path / "cli.txt").read_bytes()
+    raw = [E.ObjectRelocalizer(map_, camera).relocalize(f) for f in frames]
+    truth = E.read_trajectory(d / "keyframes.groundtruth.txt")
+    errors = [(E.pose_error(u.pose, truth[E.find_nearest(truth, f.timestamp)].pose),
+               E.pose_error(r.pose, truth[E.find_nearest(truth, f.timestamp)].pose))
+              for f, u, r in zip(frames, results, raw) if u.success and r.success]
+    both = [(u.position_cm, r.position_cm) for u, r in errors if u.valid and r.valid]
+    assert len(both) > 100
+    assert np.median([u for u, _ in both]) < np.median([r for _, r in both])
+    # The observations moved: a box near the border by several pixels.
+    moved = max(abs(a.box.x1 - b.box.x1) for f in frames[:20]
+                for a, b in zip(undistorted.observe(f), E.ObjectRelocalizer(map_, camera).observe(f)))
+    assert moved > 3.0
+    with pytest.raises(ValueError, match="lens"):
+        E.ObjectRelocalizer(map_, E.Intrinsics(500, 500, 320, 240, 640, 480), lens=lens)
+
+
 def test_a_pose_region_gives_the_command_lines_near_poses(fr2, data_dir, cli, tmp_path):
     """Each keyframe searched within 0.3 m and 20 degrees of the previous keyframe's true pose,
     through Python and through `--near`; every pose lies in its region."""

@@ -80,10 +80,14 @@ int yamlInteger(const std::map<std::string, std::string>& values, const std::str
   return static_cast<int>(v);
 }
 
-Intrinsics readYaml(const std::string& path) {
+std::map<std::string, std::string> yamlValues(const std::string& path) {
   const std::string text = readTextFile(path);  // names the file if it does not exist
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error(path + ": empty file, expected a camera");
-  const std::map<std::string, std::string> values = yamlTopLevel(text, path);
+  return yamlTopLevel(text, path);
+}
+
+Intrinsics readYaml(const std::string& path) {
+  const std::map<std::string, std::string> values = yamlValues(path);
   Intrinsics K;
   K.fx = yamlNumber(values, "Camera.fx", path);
   K.fy = yamlNumber(values, "Camera.fy", path);
@@ -94,7 +98,41 @@ Intrinsics readYaml(const std::string& path) {
   return K;
 }
 
+/// The distortion keys, in the order of Distortion's fields; a key left out is 0.
+constexpr const char* kDistortionKeys[5] = {"k1", "k2", "p1", "p2", "k3"};
+
+Distortion readDistortionYaml(const std::string& path) {
+  const std::map<std::string, std::string> values = yamlValues(path);
+  double k[5] = {0, 0, 0, 0, 0};
+  for (int i = 0; i < 5; ++i) {
+    const std::string key = std::string("Camera.") + kDistortionKeys[i];
+    if (values.count(key)) k[i] = yamlNumber(values, key, path);
+  }
+  return {k[0], k[1], k[2], k[3], k[4]};
+}
+
+Distortion readDistortionJson(const std::string& path) {
+  using namespace detail;
+  const json j = parseJson(readTextFile(path), path);
+  const Where where{path, ""};
+  if (!j.is_object()) where.fail("expected an object");
+  double k[5] = {0, 0, 0, 0, 0};
+  for (int i = 0; i < 5; ++i)
+    if (j.contains(kDistortionKeys[i])) k[i] = finiteNumber(j.at(kDistortionKeys[i]), where[kDistortionKeys[i]]);
+  return {k[0], k[1], k[2], k[3], k[4]};
+}
+
 }  // namespace
+
+Distortion readDistortion(const std::string& path) {
+  return endsWith(path, ".json") ? readDistortionJson(path) : readDistortionYaml(path);
+}
+
+Lens readLens(const std::string& path) {
+  Lens lens{readCamera(path), readDistortion(path)};
+  if (const std::string why = lens.whyNotUsable(); !why.empty()) throw Error(path + ": " + why);
+  return lens;
+}
 
 Intrinsics readCamera(const std::string& path) {
   const Intrinsics K = endsWith(path, ".json") ? readJson(path) : readYaml(path);

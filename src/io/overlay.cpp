@@ -41,12 +41,27 @@ std::vector<std::optional<Ellipse>> projectMap(const ObjectMap& map, const Intri
   return out;
 }
 
-cv::Mat canvas(const Intrinsics& K, const std::string& background) {
+/// The raw image resampled as the pinhole camera of the same intrinsics sees it.
+cv::Mat undistorted(const cv::Mat& raw, const Lens& lens) {
+  cv::Mat map_x(raw.rows, raw.cols, CV_32FC1), map_y(raw.rows, raw.cols, CV_32FC1);
+  for (int y = 0; y < raw.rows; ++y)
+    for (int x = 0; x < raw.cols; ++x) {
+      const Eigen::Vector2d p = lens.distortion.distortPixel(lens.intrinsics, {x, y});
+      map_x.at<float>(y, x) = static_cast<float>(p.x());
+      map_y.at<float>(y, x) = static_cast<float>(p.y());
+    }
+  cv::Mat out;
+  cv::remap(raw, out, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
+  return out;
+}
+
+cv::Mat canvas(const Intrinsics& K, const std::string& background, const Lens* lens) {
   if (background.empty()) return cv::Mat(K.height, K.width, CV_8UC3, cv::Scalar(245, 245, 245));
   const std::string bytes = readTextFile(background);
   DecodedImage decoded = decodeImage(bytes, background, DecodeAs::Bgr8);
   cv::Mat img(decoded.height, decoded.width, CV_8UC3, decoded.pixels.data());
   if (img.cols != K.width || img.rows != K.height) cv::resize(img, img, cv::Size(K.width, K.height));
+  if (lens && !lens->distortion.isZero()) img = undistorted(img, *lens);
   // Lighter, so that the drawing stands out (into a new matrix: `img` may view `decoded`).
   cv::Mat lighter;
   img.convertTo(lighter, -1, 0.6, 90);
@@ -56,8 +71,8 @@ cv::Mat canvas(const Intrinsics& K, const std::string& background) {
 }  // namespace
 
 void writeOverlay(const std::string& path, const Intrinsics& K, const ObjectMap& map, const OverlayContent& content,
-                  const std::string& background) {
-  cv::Mat img = canvas(K, background);
+                  const std::string& background, const Lens* lens) {
+  cv::Mat img = canvas(K, background, lens);
   if (content.truth)
     for (const std::optional<Ellipse>& e : projectMap(map, K, *content.truth))
       if (e) drawEllipse(img, *e, kTruth, 1);

@@ -41,6 +41,8 @@ std::string ObserveOptions::validate() const {
   };
   for (const auto& [name, ok] : checks)
     if (!ok) return std::string("observe options: ") + name + " is out of range or not a number";
+  if (lens)
+    if (const std::string why = lens->whyNotUsable(); !why.empty()) return "observe options: lens: " + why;
   return "";
 }
 
@@ -67,13 +69,11 @@ bool parseObservationPolicy(const std::string& name, ObservationPolicy* policy) 
   return false;
 }
 
-ObserveResult observeDetection(const Detection& d, int width, int height, const ObserveOptions& opt) {
+namespace {
+
+/// observeDetection in the raw image, without the lens.
+ObserveResult observeRaw(const Detection& d, int width, int height, const ObserveOptions& opt) {
   ObserveResult r;
-  if (std::string problem = opt.validate(); !problem.empty()) {
-    r.status = ObserveStatus::InvalidOptions;
-    r.note = std::move(problem);
-    return r;
-  }
   const Box image(-0.5, -0.5, width - 0.5, height - 0.5);
   if (!d.bbox.isValid() || !(d.bbox.width() > 0) || !(d.bbox.height() > 0) ||
       !(d.bbox.intersection(image).area() > 0)) {
@@ -151,6 +151,45 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
   obs.ellipse = *fitted;
   obs.source = EllipseSource::Mask;
   r.observation = obs;
+  return r;
+}
+
+/// An observation of the raw image moved to the pinhole image: its box undistorted, and its
+/// ellipse inscribed in that box when it came from the box (OA-SLAM's model, in the pinhole
+/// image), else undistorted. The regular and border tests stay the raw image's.
+bool undistort(const Lens& lens, Observation* o) {
+  const std::optional<Box> box = lens.undistortBox(o->box);
+  if (!box) return false;
+  o->box = *box;
+  const std::optional<Ellipse> e =
+      o->source == EllipseSource::Box ? Ellipse::inscribedInBox(*box) : lens.undistortEllipse(o->ellipse);
+  if (!e || !e->isValid()) return false;
+  o->ellipse = *e;
+  return true;
+}
+
+}  // namespace
+
+ObserveResult observeDetection(const Detection& d, int width, int height, const ObserveOptions& opt) {
+  ObserveResult r;
+  if (std::string problem = opt.validate(); !problem.empty()) {
+    r.status = ObserveStatus::InvalidOptions;
+    r.note = std::move(problem);
+    return r;
+  }
+  if (opt.lens && (opt.lens->intrinsics.width != width || opt.lens->intrinsics.height != height)) {
+    r.status = ObserveStatus::InvalidOptions;
+    r.note = "observe options: lens: its intrinsics are of a " + std::to_string(opt.lens->intrinsics.width) + "x" +
+             std::to_string(opt.lens->intrinsics.height) + " image, the detections of a " + std::to_string(width) +
+             "x" + std::to_string(height) + " one";
+    return r;
+  }
+  r = observeRaw(d, width, height, opt);
+  if (opt.lens && !opt.lens->distortion.isZero() && r.observation && !undistort(*opt.lens, &*r.observation)) {
+    r.status = ObserveStatus::InvalidBox;
+    r.observation.reset();
+    r.note = "the box reaches where the lens's distortion cannot be undone";
+  }
   return r;
 }
 

@@ -13,6 +13,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     try {
       const Intrinsics K = io::readCamera(fuzz::writeScratch(data, size, ext));
       FUZZ_CHECK(K.isValid());  // a camera is valid or an error
+      // A lens is one that can be undone over its image, or an error; a pinhole pixel found for a
+      // raw one is finite and the lens maps it back.
+      const Lens lens = io::readLens(fuzz::writeScratch(data, size, ext));
+      FUZZ_CHECK(lens.whyNotUsable().empty());
+      for (const Eigen::Vector2d raw : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(K.width - 0.5, K.height - 0.5),
+                                        Eigen::Vector2d(K.cx, K.cy), Eigen::Vector2d(0.0, K.height / 2.0)})
+        if (const std::optional<Eigen::Vector2d> u = lens.undistortPixel(raw)) {
+          FUZZ_CHECK(u->allFinite());
+          FUZZ_CHECK((lens.distortion.distortPixel(K, *u) - raw).norm() <= 1e-6 * (1.0 + raw.norm()));
+        }
     } catch (const Error&) {
     }
   }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "ellreloc/core/camera.hpp"
+#include "ellreloc/core/distortion.hpp"
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/core/observation.hpp"
 #include "ellreloc/core/pose.hpp"
@@ -30,9 +31,10 @@ struct OverlayContent {
 
 /// Draws `content` over the image at `background` (any format OpenCV reads; an image of
 /// another size than the camera's is scaled to it) or, when `background` is empty, over a
-/// blank canvas, and writes a PNG atomically. Throws ellreloc::Error naming the file when the
-/// background cannot be read or the PNG written.
+/// blank canvas, and writes a PNG atomically. With a `lens`, the background is a raw image of
+/// that distorted lens and is undistorted first, as the observations were (ObserveOptions::lens).
+/// Throws ellreloc::Error naming the file when the background cannot be read or the PNG written.
 void writeOverlay(const std::string& path, const Intrinsics& K, const ObjectMap& map, const OverlayContent& content,
-                  const std::string& background = "");
+                  const std::string& background = "", const Lens* lens = nullptr);
 
 }  // namespace ellreloc::io

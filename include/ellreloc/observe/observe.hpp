@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/distortion.hpp"
 #include "ellreloc/core/observation.hpp"
 #include "ellreloc/observe/regular_mask.hpp"
 
@@ -54,6 +55,12 @@ struct ObserveOptions {
   /// hull is mostly gaps (thin parts, fragments of a partly hidden object): it keeps the box.
   double solid_min_solidity = 0.5;
   double border_px = 2.0;  ///< a box this close to the image border is flagged truncated
+  /// The camera of the raw image the detections were made on, when its lens distorts: each
+  /// observation is made in the raw image (mask fits, the regular and border tests), then
+  /// moved to the pinhole image of the same intrinsics that the map's projections assume: its
+  /// box undistorted (Lens::undistortBox) and its ellipse inscribed in that box, or undistorted
+  /// when it came from a mask or the detection file. Unset: the detections are taken as pinhole.
+  std::optional<Lens> lens;
 
   /// Empty when every threshold is finite and in range, else one line naming the first that
   /// is not; observeDetection then answers InvalidOptions.
