@@ -38,12 +38,14 @@ struct Distortion {
             x(1) * radial + p1 * (r2 + 2.0 * x(1) * x(1)) + 2.0 * p2 * x(0) * x(1)};
   }
 
-  /// The undistorted normalised coordinates of distorted ones, by Newton's method from x_d (the
-  /// model has no closed-form inverse). nullopt when it does not converge to 1e-12, as where
-  /// the model folds over (beyond the radius where its radial part stops growing).
-  std::optional<Eigen::Vector2d> undistort(const Eigen::Vector2d& xd) const {
+  /// The undistorted normalised coordinates of distorted ones, by Newton's method from `start`
+  /// (x_d when not given; the model has no closed-form inverse). nullopt when it does not
+  /// converge to 1e-12, as where the model folds over (beyond the radius where its radial part
+  /// stops growing).
+  std::optional<Eigen::Vector2d> undistort(const Eigen::Vector2d& xd,
+                                           const std::optional<Eigen::Vector2d>& start = std::nullopt) const {
     if (!xd.allFinite()) return std::nullopt;
-    Eigen::Vector2d x = xd;
+    Eigen::Vector2d x = start && start->allFinite() ? *start : xd;
     for (int iteration = 0; iteration < 30; ++iteration) {
       const Eigen::Vector2d residual = distort(x) - xd;
       if (residual.norm() < 1e-12) return x;
@@ -70,8 +72,12 @@ struct Distortion {
   }
 
   /// The undistorted image's pixel of a raw image's pixel `uv`; nullopt where undistort() is.
-  std::optional<Eigen::Vector2d> undistortPixel(const Intrinsics& K, const Eigen::Vector2d& uv) const {
-    const std::optional<Eigen::Vector2d> x = undistort({(uv(0) - K.cx) / K.fx, (uv(1) - K.cy) / K.fy});
+  /// `near`: a pinhole pixel close to the answer (a neighbour's), where Newton's method starts.
+  std::optional<Eigen::Vector2d> undistortPixel(const Intrinsics& K, const Eigen::Vector2d& uv,
+                                                const std::optional<Eigen::Vector2d>& near = std::nullopt) const {
+    std::optional<Eigen::Vector2d> start;
+    if (near) start = Eigen::Vector2d(((*near)(0) - K.cx) / K.fx, ((*near)(1) - K.cy) / K.fy);
+    const std::optional<Eigen::Vector2d> x = undistort({(uv(0) - K.cx) / K.fx, (uv(1) - K.cy) / K.fy}, start);
     if (!x) return std::nullopt;
     return Eigen::Vector2d(K.fx * (*x)(0) + K.cx, K.fy * (*x)(1) + K.cy);
   }
@@ -112,9 +118,11 @@ struct Lens {
   /// Why the lens cannot be undone over its image, or "" (Distortion::whyNotInvertible).
   std::string whyNotUsable() const { return distortion.whyNotInvertible(intrinsics); }
 
-  /// The pinhole pixel of a raw pixel; nullopt where the model cannot be undone.
-  std::optional<Eigen::Vector2d> undistortPixel(const Eigen::Vector2d& raw) const {
-    return distortion.undistortPixel(intrinsics, raw);
+  /// The pinhole pixel of a raw pixel; nullopt where the model cannot be undone. `near`: a
+  /// pinhole pixel close to the answer, where the search starts.
+  std::optional<Eigen::Vector2d> undistortPixel(const Eigen::Vector2d& raw,
+                                                const std::optional<Eigen::Vector2d>& near = std::nullopt) const {
+    return distortion.undistortPixel(intrinsics, raw, near);
   }
 
   /// The bounding box of a raw box's outline once undistorted: the object lies inside the raw
@@ -122,14 +130,14 @@ struct Lens {
   /// for an invalid box or one reaching where the model cannot be undone.
   std::optional<Box> undistortBox(const Box& raw) const {
     if (!raw.isValid()) return std::nullopt;
-    constexpr int kSamplesPerSide = 32;  // a bent side followed to a small fraction of a pixel
+    constexpr int kSamplesPerSide = 16;  // a side bends by pixels: followed to a hundredth of one
     const Eigen::Vector2d corners[4] = {{raw.x1, raw.y1}, {raw.x2, raw.y1}, {raw.x2, raw.y2}, {raw.x1, raw.y2}};
     Box out(INFINITY, INFINITY, -INFINITY, -INFINITY);
+    std::optional<Eigen::Vector2d> u;  // the previous sample's: each search starts next to the answer
     for (int side = 0; side < 4; ++side)
       for (int k = 0; k < kSamplesPerSide; ++k) {
         const double t = static_cast<double>(k) / kSamplesPerSide;
-        const std::optional<Eigen::Vector2d> u =
-            undistortPixel((1.0 - t) * corners[side] + t * corners[(side + 1) % 4]);
+        u = undistortPixel((1.0 - t) * corners[side] + t * corners[(side + 1) % 4], u);
         if (!u) return std::nullopt;
         out =
             Box(std::min(out.x1, u->x()), std::min(out.y1, u->y()), std::max(out.x2, u->x()), std::max(out.y2, u->y()));
@@ -142,9 +150,9 @@ struct Lens {
   std::optional<Ellipse> undistortEllipse(const Ellipse& raw) const {
     constexpr int kVertices = 256;
     std::vector<Eigen::Vector2d> outline = raw.sampleBoundary(kVertices);
+    std::optional<Eigen::Vector2d> u;  // the previous vertex's: each search starts next to the answer
     for (Eigen::Vector2d& p : outline) {
-      const std::optional<Eigen::Vector2d> u = undistortPixel(p);
-      if (!u) return std::nullopt;
+      if (!(u = undistortPixel(p, u))) return std::nullopt;
       p = *u;
     }
     const std::optional<Ellipse> e = ellipseOfPolygon(outline);
