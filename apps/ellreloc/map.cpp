@@ -26,12 +26,24 @@ namespace {
 
 std::string absoluteNormal(const fs::path& p) { return fs::absolute(p).lexically_normal().string(); }
 
-/// The frames that have a pose in the trajectory, with that pose.
+/// The frames that have a pose in the trajectory, with that pose; with a lens, their boxes
+/// undistorted (one that cannot be, far outside the image, is left out).
 std::vector<PosedDetections> posedFrames(const std::vector<DetectionFrame>& frames,
-                                         const std::vector<io::StampedPose>& trajectory) {
+                                         const std::vector<io::StampedPose>& trajectory,
+                                         const std::optional<Lens>& lens) {
   std::vector<PosedDetections> out;
   for (const DetectionFrame& f : frames)
-    if (const Pose* pose = io::framePose(trajectory, f)) out.push_back({*pose, f.detections});
+    if (const Pose* pose = io::framePose(trajectory, f)) {
+      out.push_back({*pose, {}});
+      for (Detection d : f.detections) {
+        if (lens) {
+          const std::optional<Box> box = lens->undistortBox(d.bbox);
+          if (!box) continue;
+          d.bbox = *box;
+        }
+        out.back().detections.push_back(std::move(d));
+      }
+    }
   return out;
 }
 
@@ -95,6 +107,9 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
                 "only); voxel mode takes it as the ellipsoids' up")
       ->expected(3)
       ->delimiter(',');
+  m->add_flag("--undistort", a.undistort,
+              "boxes mode: the detections were made on raw images of a distorted lens: undistort their boxes with "
+              "the --camera file's Camera.k1, k2, p1, p2, k3 (left out: 0)");
   m->add_option("--holdout-every", a.holdout_every,
                 "leave every N-th frame out of the map and report how well the map explains its boxes")
       ->check(CLI::Range(2, 1000000));
@@ -123,6 +138,9 @@ void map(const MapArgs& a, const Console& console) {
     options.ellipsoid.up = up.normalized();
     options.boxes.up = up.normalized();
   }
+  if (a.undistort && options.mode == MappingMode::Voxel)
+    throw Error("--undistort: boxes mode only (voxel mode reads masks and depth images as pinhole images)");
+  if (a.undistort) options.lens = io::readLens(a.camera);
   const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   std::vector<io::Association> associations;
@@ -134,12 +152,12 @@ void map(const MapArgs& a, const Console& console) {
 
   Mapper mapper(K, options);
   std::vector<PosedDetections> held_out;
-  if (!a.holdout.empty()) held_out = posedFrames(io::readDetections(a.holdout), trajectory);
+  if (!a.holdout.empty()) held_out = posedFrames(io::readDetections(a.holdout), trajectory, options.lens);
   int used = 0, no_pose = 0, no_depth = 0;
   for (size_t i = 0; i < frames.size(); ++i) {
     const DetectionFrame& f = frames[i];
     if (a.holdout_every > 0 && i % static_cast<size_t>(a.holdout_every) == static_cast<size_t>(a.holdout_every) - 1) {
-      std::vector<PosedDetections> one = posedFrames({f}, trajectory);
+      std::vector<PosedDetections> one = posedFrames({f}, trajectory, options.lens);
       held_out.insert(held_out.end(), one.begin(), one.end());
       continue;
     }

@@ -295,6 +295,7 @@ class MapperOptions:
     min_score: float
     estimate_up_from_floor: bool
     min_mask_pixels: int
+    lens: Optional[Lens]
     def validate(self) -> str: ...
 
 

@@ -97,6 +97,8 @@ void bindMapperOptions(py::module_& m) {
       .def_readwrite("min_score", &MapperOptions::min_score)
       .def_readwrite("estimate_up_from_floor", &MapperOptions::estimate_up_from_floor)
       .def_readwrite("min_mask_pixels", &MapperOptions::min_mask_pixels)
+      .def_readwrite("lens", &MapperOptions::lens,
+                     "boxes mode: the Lens of the raw images the boxes were detected on (they are undistorted)")
       .def("validate", &MapperOptions::validate);
 }
 

@@ -77,12 +77,8 @@ Relocalizer makeRelocalizer(ObjectMap map, const Intrinsics& K, const std::optio
   ObserveOptions observe;
   observe.policy = method == "oa-slam" ? ObservationPolicy::Bbox : ObservationPolicy::Solid;
   if (!policy.is_none()) observe.policy = policyFrom(policy);
-  if (lens) {
-    const Intrinsics& L = lens->intrinsics;
-    if (L.fx != K.fx || L.fy != K.fy || L.cx != K.cx || L.cy != K.cy || L.width != K.width || L.height != K.height)
-      badArgument("lens", "its intrinsics are not the camera's");
-    observe.lens = lens;
-  }
+  if (lens && lens->intrinsics != K) badArgument("lens", "its intrinsics are not the camera's");
+  observe.lens = lens;
   return Relocalizer{ObjectRelocalizer(std::move(map), K, options), observe, method};
 }
 

@@ -154,6 +154,32 @@ def test_box_mapping_of_real_frames_equals_the_command_line(data_dir, cli, tmp_p
     assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
 
 
+def test_box_mapping_through_a_lens_equals_the_command_line(data_dir, cli, tmp_path):
+    """fr2's keyframe boxes, detected on its raw images: `map --undistort` and a Mapper given the
+    camera file's lens build the same map, which differs from the raw boxes' map."""
+    d = data_dir / "tum_fr2_desk"
+    frames = E.read_detections(d / "keyframes.detections.json")[0::2]
+    (tmp_path / "rgb").mkdir()
+    E.write_detections(tmp_path / "detections.json", frames)
+    subprocess.run([cli, "map", "--camera", str(d / "camera.yaml"), "--trajectory", str(d / "keyframes.groundtruth.txt"),
+                    "--detections", str(tmp_path / "detections.json"), "--mode", "boxes", "--undistort",
+                    "--out", str(tmp_path / "cli.json")], check=True, capture_output=True)
+    truth = E.read_trajectory(d / "keyframes.groundtruth.txt")
+    maps = []
+    for lens in (E.read_lens(d / "camera.yaml"), None):
+        options = E.MapperOptions()
+        options.lens = lens
+        mapper = E.Mapper(E.read_camera(d / "camera.yaml"), options, mode=E.MappingMode.boxes)
+        for f in frames:
+            mapper.add_keyframe(truth[E.find_nearest(truth, f.timestamp)].pose, f.detections)
+        mapper.finish()
+        maps.append(mapper.map())
+    E.write_map(tmp_path / "python.json", maps[0])
+    assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    E.write_map(tmp_path / "raw.json", maps[1])
+    assert (tmp_path / "raw.json").read_bytes() != (tmp_path / "cli.json").read_bytes()
+
+
 def test_a_mapped_map_keeps_the_relocalizer_where_it_was_made(data_dir, tmp_path):
     d = data_dir / "tum_fr3_office_first_half"
     camera, truth = E.read_camera(d / "camera.yaml"), E.read_trajectory(d / "groundtruth.txt")

@@ -250,7 +250,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
   for (const BoxView& v : all_views) {
     if (!v.pose.isValid() || !v.box.isValid() || !(v.box.area() > 1.0)) continue;
     valid.push_back(v);
-    if (!v.box.nearImageBorder(K.width, K.height, options.border_px)) inside.push_back(v);
+    if (!(v.cut ? *v.cut : v.box.nearImageBorder(K.width, K.height, options.border_px))) inside.push_back(v);
   }
   const std::vector<BoxView> views = spread(inside.size() >= options.min_views ? inside : valid, options.max_views);
   out.views_used = static_cast<int>(views.size());

@@ -140,12 +140,17 @@ std::string MapperOptions::validate() const {
   if (!unit(ellipsoid.up)) return "ellipsoid.up is zero or not finite";
   if (!unit(floor.prior_up)) return "floor.prior_up is zero or not finite";
   if (boxes.up && !unit(*boxes.up)) return "boxes.up is zero or not finite";
+  if (lens && mode == MappingMode::Voxel)
+    return "lens: voxel mode reads masks and depth images as pinhole images (undistort the images instead)";
+  if (lens)
+    if (const std::string why = lens->whyNotUsable(); !why.empty()) return "lens: " + why;
   return "";
 }
 
 Mapper::Mapper(const Intrinsics& K, const MapperOptions& options) : K_(K), options_(options) {
   if (!K.isValid()) throw Error("mapper: invalid camera intrinsics");
   if (const std::string problem = options.validate(); !problem.empty()) throw Error("mapper: " + problem);
+  if (options.lens && options.lens->intrinsics != K) throw Error("mapper: lens: its intrinsics are not the camera's");
 }
 
 void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const {
@@ -183,11 +188,17 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
     floor.seed = options_.floor.seed + static_cast<uint64_t>(keyframes_);
     if (const auto plane = estimateFloor(K_, pose, *depth, floor)) floor_normal_sum_ += plane->inlier_share * plane->up;
   }
-  const std::vector<Detection> ordered = inCanonicalOrder(detections);
+  std::vector<Detection> ordered = inCanonicalOrder(detections);
+  std::vector<bool> cut;  // by the raw image's border, for boxes undistorted from it
+  if (options_.lens && options_.mode == MappingMode::Boxes)
+    for (Detection& d : ordered) {
+      cut.push_back(d.bbox.nearImageBorder(K_.width, K_.height, options_.boxes.border_px));
+      d.bbox = options_.lens->undistortBox(d.bbox).value_or(Box());  // an empty box is ignored
+    }
   if (options_.mode == MappingMode::Voxel)
     addVoxelKeyframe(pose, ordered, *depth, &report);
   else
-    addBoxKeyframe(pose, ordered, &report);
+    addBoxKeyframe(pose, ordered, cut, &report);
   // Forget candidates that were not seen again (false detections, passing clutter).
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
                                [&](const Track& t) {
@@ -387,7 +398,8 @@ std::vector<int> Mapper::associate2D(const std::vector<std::pair<size_t, std::ve
   return tracked;
 }
 
-void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report) {
+void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, const std::vector<bool>& cut,
+                            KeyframeReport* report) {
   std::vector<size_t> used;
   for (size_t j = 0; j < detections.size(); ++j) {
     if (detections[j].score < options_.min_score || !(detections[j].bbox.area() > 1.0) ||
@@ -441,7 +453,7 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
       t->id = next_id_++;
       ++report->new_objects;
     }
-    t->views.push_back({pose, d.bbox});
+    t->views.push_back({pose, d.bbox, cut.empty() ? std::nullopt : std::optional<bool>(cut[used[k]])});
     t->keyframes_seen.push_back(keyframes_);
     observed(*t, d);
   }

@@ -26,6 +26,11 @@ struct Intrinsics {
            width > 0 && height > 0;
   }
 
+  bool operator==(const Intrinsics& o) const {
+    return fx == o.fx && fy == o.fy && cx == o.cx && cy == o.cy && width == o.width && height == o.height;
+  }
+  bool operator!=(const Intrinsics& o) const { return !(*this == o); }
+
   Eigen::Matrix3d K() const {
     Eigen::Matrix3d k;
     k << fx, 0, cx, 0, fy, cy, 0, 0, 1;

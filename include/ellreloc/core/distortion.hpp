@@ -122,6 +122,7 @@ struct Lens {
   /// pinhole pixel close to the answer, where the search starts.
   std::optional<Eigen::Vector2d> undistortPixel(const Eigen::Vector2d& raw,
                                                 const std::optional<Eigen::Vector2d>& near = std::nullopt) const {
+    if (distortion.isZero()) return raw;  // exactly: no round trip through normalised coordinates
     return distortion.undistortPixel(intrinsics, raw, near);
   }
 
@@ -130,6 +131,7 @@ struct Lens {
   /// for an invalid box or one reaching where the model cannot be undone.
   std::optional<Box> undistortBox(const Box& raw) const {
     if (!raw.isValid()) return std::nullopt;
+    if (distortion.isZero()) return raw;
     constexpr int kSamplesPerSide = 16;  // a side bends by pixels: followed to a hundredth of one
     const Eigen::Vector2d corners[4] = {{raw.x1, raw.y1}, {raw.x2, raw.y1}, {raw.x2, raw.y2}, {raw.x1, raw.y2}};
     Box out(INFINITY, INFINITY, -INFINITY, -INFINITY);
@@ -148,6 +150,7 @@ struct Lens {
   /// The ellipse with the area moments of a raw ellipse's outline once undistorted; nullopt
   /// where the model cannot be undone.
   std::optional<Ellipse> undistortEllipse(const Ellipse& raw) const {
+    if (distortion.isZero()) return raw;
     constexpr int kVertices = 256;
     std::vector<Eigen::Vector2d> outline = raw.sampleBoundary(kVertices);
     std::optional<Eigen::Vector2d> u;  // the previous vertex's: each search starts next to the answer

@@ -26,6 +26,10 @@ namespace ellreloc {
 struct BoxView {
   Pose pose;
   Box box;
+  /// The image border cuts the box (the object may go on past it); unset: judged from the box
+  /// (within BoxEllipsoidOptions::border_px of the border). Set for boxes undistorted from a raw
+  /// image, whose border is not the pinhole image's.
+  std::optional<bool> cut;
 };
 
 /// What is known of an object's size before its boxes: its category's typical semi-axes

@@ -23,6 +23,7 @@
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/depth_image.hpp"
 #include "ellreloc/core/detection.hpp"
+#include "ellreloc/core/distortion.hpp"
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/mapping/association.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
@@ -59,6 +60,11 @@ struct MapperOptions {
   bool estimate_up_from_floor = false;
   FloorOptions floor;
   long min_mask_pixels = 30;  ///< smaller masks are ignored
+  /// Boxes mode: the keyframes' detections were made on the raw images of this distorted lens
+  /// (core/distortion.hpp): each box is undistorted to the pinhole image the ellipsoids project
+  /// into, and whether the image border cuts it is judged on the raw box. Its intrinsics must be
+  /// the mapper's. Voxel mode reads masks and depth images as pinhole images and refuses it.
+  std::optional<Lens> lens;
 
   /// Empty when every field is finite and in range, else one line naming the first that is
   /// not; the Mapper's constructor throws it.
@@ -146,7 +152,10 @@ class Mapper {
   std::vector<int> associate2D(const std::vector<std::pair<size_t, std::vector<Box>>>& expected,
                                const std::vector<Detection>& detections, const std::vector<size_t>& used,
                                const PairGate& gate = {}) const;
-  void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, KeyframeReport* report);
+  /// `cut`: per detection, whether the raw image's border cuts its box (BoxView::cut); empty
+  /// when the boxes are the pinhole image's.
+  void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, const std::vector<bool>& cut,
+                      KeyframeReport* report);
   void observed(Track& track, const Detection& detection);
   void mergeDuplicateBoxTracks();
   void mergeDuplicateVoxelTracks();
