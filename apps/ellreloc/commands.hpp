@@ -40,6 +40,11 @@ struct NamedPath {
 /// that exists and is not a regular file. Empty paths are skipped.
 void checkPaths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
 
+/// For a command run without --undistort: says so when the camera file gives a lens distortion
+/// (the detections may have been made on its raw images). Prints nothing for a camera without
+/// one, or whose distortion keys do not read (they are not used).
+void mentionTheLens(const std::string& camera);
+
 struct SimulateArgs {
   std::string preset = "office", noise = "realistic", out;
   unsigned long seed = 1;

@@ -6,6 +6,8 @@
 #include <string>
 
 #include "commands.hpp"
+#include "ellreloc/error.hpp"
+#include "ellreloc/io/camera.hpp"
 
 namespace ellreloc::cli {
 
@@ -32,6 +34,18 @@ std::string fileIdentity(const std::string& path) {
 }
 
 }  // namespace
+
+void mentionTheLens(const std::string& camera) {
+  try {
+    if (io::readDistortion(camera).isZero()) return;
+  } catch (const Error&) {
+    return;
+  }
+  std::printf(
+      "%s gives a lens distortion (Camera.k1 ...): if the detections were made on its raw images, --undistort moves "
+      "them to the pinhole image the map is projected into\n",
+      camera.c_str());
+}
 
 void checkPaths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
   std::vector<std::pair<std::string, const NamedPath*>> seen;

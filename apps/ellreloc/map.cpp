@@ -140,7 +140,10 @@ void map(const MapArgs& a, const Console& console) {
   }
   if (a.undistort && options.mode == MappingMode::Voxel)
     throw Error("--undistort: boxes mode only (voxel mode reads masks and depth images as pinhole images)");
-  if (a.undistort) options.lens = io::readLens(a.camera);
+  if (a.undistort)
+    options.lens = io::readLens(a.camera);
+  else if (options.mode == MappingMode::Boxes && !console.quiet)
+    mentionTheLens(a.camera);
   const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   std::vector<io::Association> associations;

@@ -565,6 +565,8 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     if (observe_options.lens->distortion.isZero() && !console.quiet)
       std::printf("%s: no distortion (Camera.k1 ... all 0 or left out): --undistort changes nothing\n",
                   a.camera.c_str());
+  } else if (!console.quiet) {
+    mentionTheLens(a.camera);
   }
   const ObjectRelocalizer relocalizer(object_map, K, options);
   if (const auto& up = relocalizer.upFromObjects(); up && !console.quiet)

@@ -11,6 +11,7 @@
 #include "ellreloc/core/depth_image.hpp"
 #include "ellreloc/core/detection.hpp"
 #include "ellreloc/core/distances.hpp"
+#include "ellreloc/core/distortion.hpp"
 #include "ellreloc/core/ellipse.hpp"
 #include "ellreloc/core/ellipsoid.hpp"
 #include "ellreloc/core/map_up.hpp"
