@@ -121,19 +121,20 @@ void bindFiles(py::module_& m) {
       "write_overlay",
       [](const py::handle& path, const Intrinsics& K, const ObjectMap& map, std::vector<Observation> observations,
          const std::optional<Pose>& pose, const std::optional<Pose>& truth, std::vector<std::pair<int, int>> matches,
-         std::vector<std::string> text, const py::handle& background) {
+         std::vector<std::string> text, const py::handle& background, const std::optional<Lens>& lens) {
         io::OverlayContent c{std::move(observations), pose, truth, std::move(matches), std::move(text)};
         const std::string out = pathFrom(path), image = background.is_none() ? "" : pathFrom(background);
         py::gil_scoped_release release;
-        io::writeOverlay(out, K, map, c, image);
+        io::writeOverlay(out, K, map, c, image, lens ? &*lens : nullptr);
       },
       py::arg("path"), py::arg("camera"), py::arg("map"), py::arg("observations"), py::arg("pose") = py::none(),
       py::arg("truth") = py::none(), py::arg("matches") = std::vector<std::pair<int, int>>{},
-      py::arg("text") = std::vector<std::string>{}, py::arg("background") = py::none(),
+      py::arg("text") = std::vector<std::string>{}, py::arg("background") = py::none(), py::arg("lens") = py::none(),
       "A PNG picture of one relocalization (what `ellreloc relocalize --overlays` draws): observations in green, "
       "the map projected with `pose` in orange, `matches` ((observation, object index) pairs, e.g. "
       "[(m.observation, m.object) for m in result.matches]) in magenta, the map at `truth` in blue, `text` at "
-      "the top left, over the `background` image or a blank canvas.");
+      "the top left, over the `background` image or a blank canvas; with a `lens`, the background is a raw image "
+      "of it and is undistorted first.");
   py::class_<io::Association>(m, "Association", "A line of a TUM association file.")
       .def_readonly("rgb_time", &io::Association::rgb_time)
       .def_readonly("rgb_path", &io::Association::rgb_path)

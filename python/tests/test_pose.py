@@ -343,3 +343,8 @@ def test_overlays_from_python(office, tmp_path):
     with pytest.raises(OSError, match="missing.png: cannot open"):
         E.write_overlay(tmp_path / "b.png", camera, map_, observations, background=tmp_path / "missing.png")
     assert not (tmp_path / "b.png").exists()
+    # A raw background through a lens is undistorted first: the picture differs, its size does not.
+    lens = E.Lens(camera, E.Distortion(k1=0.2))
+    E.write_overlay(tmp_path / "c.png", camera, map_, observations, background=tmp_path / "a.png", lens=lens)
+    E.write_overlay(tmp_path / "d.png", camera, map_, observations, background=tmp_path / "a.png")
+    assert (tmp_path / "c.png").read_bytes() != (tmp_path / "d.png").read_bytes()

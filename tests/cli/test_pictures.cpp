@@ -7,12 +7,14 @@
 #include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <regex>
 
 #include "cli/cli_run.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/io/camera.hpp"
 #include "ellreloc/io/map.hpp"
+#include "ellreloc/io/overlay.hpp"
 #include "ellreloc/io/trajectory.hpp"
 
 namespace {
@@ -149,6 +151,31 @@ TEST_F(Pictures, OverlaysTakeJpegBackgroundsAndNameAnUnreadableOne) {
   EXPECT_NE(r.err.find("rgb/" + stamp + ".png: not a PNG or JPEG image"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(dir.path("bad_overlays/" + stamp + ".png")));
+}
+
+// With a lens, the background (a raw image) is undistorted as the observations drawn over it
+// were: a spot near the corner of a raw fr2 image lands where the lens's inverse puts it.
+TEST(Overlays, ARawBackgroundIsUndistortedWithTheLens) {
+  test::TempDir dir;
+  const Intrinsics K(520.90862, 521.007327, 325.141442, 249.701764, 640, 480);
+  const Lens lens{K, {0.231222, -0.784899, -0.003257, -0.000105, 0.917205}};
+  cv::Mat raw(K.height, K.width, CV_8UC3, cv::Scalar(0, 0, 0));
+  cv::rectangle(raw, cv::Point(57, 47), cv::Point(63, 53), cv::Scalar(255, 255, 255), cv::FILLED);
+  ASSERT_TRUE(cv::imwrite(dir.path("raw.png"), raw));
+  const auto spot = [&](const Lens* l) {
+    io::writeOverlay(dir.path("overlay.png"), K, ObjectMap{}, io::OverlayContent{}, dir.path("raw.png"), l);
+    const cv::Mat img = cv::imread(dir.path("overlay.png"));
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    int n = 0;
+    for (int y = 20; y < 90; ++y)  // around the spot (the overlay draws a legend elsewhere)
+      for (int x = 20; x < 110; ++x)
+        if (img.at<cv::Vec3b>(y, x)[1] > 200) sum += Eigen::Vector2d(x, y), ++n;  // white, lightened
+    return n > 0 ? Eigen::Vector2d(sum / n) : Eigen::Vector2d(-1, -1);
+  };
+  const Eigen::Vector2d expected = *lens.undistortPixel({60.0, 50.0});
+  EXPECT_GT((expected - Eigen::Vector2d(60, 50)).norm(), 5.0);
+  EXPECT_LT((spot(&lens) - expected).norm(), 1.0);
+  EXPECT_LT((spot(nullptr) - Eigen::Vector2d(60, 50)).norm(), 0.5);
 }
 
 TEST_F(Pictures, ComparisonPlotsAndPerFrameCsvCoverEveryMethodAndFrame) {
