@@ -66,7 +66,7 @@ struct MapArgs {
   int holdout_every = 0;   ///< every N-th frame is left out of the map and measures its quality
   std::string holdout;     ///< detections of frames left out of the map, to measure its quality
   std::vector<double> up;  ///< the world's up direction, when known
-  bool undistort = false;  ///< boxes mode: the detections are of the raw images of the camera's distorted lens
+  bool undistort = false;  ///< the detections and depth images are raw images of the camera's distorted lens
 };
 CLI::App* addMapCommand(CLI::App& app, MapArgs& a);
 void map(const MapArgs& a, const Console& console);

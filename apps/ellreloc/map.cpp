@@ -108,8 +108,8 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
       ->expected(3)
       ->delimiter(',');
   m->add_flag("--undistort", a.undistort,
-              "boxes mode: the detections were made on raw images of a distorted lens: undistort their boxes with "
-              "the --camera file's Camera.k1, k2, p1, p2, k3 (left out: 0)");
+              "the detections (and depth images) are raw images of a distorted lens: undistort them with the "
+              "--camera file's Camera.k1, k2, p1, p2, k3 (left out: 0)");
   m->add_option("--holdout-every", a.holdout_every,
                 "leave every N-th frame out of the map and report how well the map explains its boxes")
       ->check(CLI::Range(2, 1000000));
@@ -138,11 +138,9 @@ void map(const MapArgs& a, const Console& console) {
     options.ellipsoid.up = up.normalized();
     options.boxes.up = up.normalized();
   }
-  if (a.undistort && options.mode == MappingMode::Voxel)
-    throw Error("--undistort: boxes mode only (voxel mode reads masks and depth images as pinhole images)");
   if (a.undistort)
     options.lens = io::readLens(a.camera);
-  else if (options.mode == MappingMode::Boxes && !console.quiet)
+  else if (!console.quiet)
     mentionTheLens(a.camera);
   const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);

@@ -98,7 +98,7 @@ void bindMapperOptions(py::module_& m) {
       .def_readwrite("estimate_up_from_floor", &MapperOptions::estimate_up_from_floor)
       .def_readwrite("min_mask_pixels", &MapperOptions::min_mask_pixels)
       .def_readwrite("lens", &MapperOptions::lens,
-                     "boxes mode: the Lens of the raw images the boxes were detected on (they are undistorted)")
+                     "the Lens of the keyframes' raw images: boxes undistorted, masks and depth images resampled")
       .def("validate", &MapperOptions::validate);
 }
 

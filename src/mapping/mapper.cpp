@@ -7,6 +7,7 @@
 #include <mutex>
 #include <tuple>
 
+#include "ellreloc/core/mask.hpp"
 #include "ellreloc/core/projection.hpp"
 #include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
@@ -14,6 +15,49 @@
 
 namespace ellreloc {
 namespace {
+
+/// For each pixel of the pinhole image (row-major), the index y * width + x of the raw pixel
+/// nearest to where the lens imaged it, or -1 outside the raw image.
+std::vector<int> rawPixelOfEachPixel(const Lens& lens) {
+  const Intrinsics& K = lens.intrinsics;
+  std::vector<int> raw(static_cast<size_t>(K.width) * static_cast<size_t>(K.height), -1);
+  for (int y = 0; y < K.height; ++y)
+    for (int x = 0; x < K.width; ++x) {
+      const Eigen::Vector2d p = lens.distortion.distortPixel(K, {x, y});
+      const double rx = std::round(p.x()), ry = std::round(p.y());
+      if (rx >= 0 && ry >= 0 && rx < K.width && ry < K.height)  // false for NaN too
+        raw[static_cast<size_t>(y) * K.width + x] = static_cast<int>(ry) * K.width + static_cast<int>(rx);
+    }
+  return raw;
+}
+
+/// A raw depth image in the pinhole image: each pixel the nearest raw reading (none is
+/// interpolated across an object's edge), 0 where no raw pixel maps.
+DepthImage pinholeDepth(const DepthImage& raw, const std::vector<int>& raw_pixel) {
+  DepthImage out = raw;
+  for (size_t i = 0; i < raw_pixel.size(); ++i)
+    out.metres[i] = raw_pixel[i] < 0 ? 0.0f : raw.metres[static_cast<size_t>(raw_pixel[i])];
+  return out;
+}
+
+/// A raw mask in the pinhole image: each pixel the nearest raw one. Only the undistorted
+/// outline of the mask's pixel box can hold it (a pixel of margin for the rounding).
+RleMask pinholeMask(const RleMask& raw, const std::vector<int>& raw_pixel, const Lens& lens) {
+  const std::optional<BinaryMask> crop = decodeMaskCrop(raw);
+  const std::optional<Box> region =
+      crop ? lens.undistortBox(
+                 Box(crop->x0 - 0.5, crop->y0 - 0.5, crop->x0 + crop->width - 0.5, crop->y0 + crop->height - 0.5))
+           : std::nullopt;
+  if (!region) return encodeRuns(raw.height, raw.width, [](int, int) { return false; });
+  const double x1 = region->x1 - 1, y1 = region->y1 - 1, x2 = region->x2 + 1, y2 = region->y2 + 1;
+  return encodeRuns(raw.height, raw.width, [&](int x, int y) {
+    if (x < x1 || x > x2 || y < y1 || y > y2) return false;
+    const int r = raw_pixel[static_cast<size_t>(y) * raw.width + x];
+    if (r < 0) return false;
+    const int lx = r % raw.width - crop->x0, ly = r / raw.width - crop->y0;
+    return crop->inside(lx, ly) && crop->at(lx, ly) != 0;
+  });
+}
 
 /// The views of a young track that place it for the next keyframe's box: its last ones, where
 /// a camera that moved on sees it (and bounding the cost of tracks that never fit).
@@ -140,8 +184,6 @@ std::string MapperOptions::validate() const {
   if (!unit(ellipsoid.up)) return "ellipsoid.up is zero or not finite";
   if (!unit(floor.prior_up)) return "floor.prior_up is zero or not finite";
   if (boxes.up && !unit(*boxes.up)) return "boxes.up is zero or not finite";
-  if (lens && mode == MappingMode::Voxel)
-    return "lens: voxel mode reads masks and depth images as pinhole images (undistort the images instead)";
   if (lens)
     if (const std::string why = lens->whyNotUsable(); !why.empty()) return "lens: " + why;
   return "";
@@ -151,6 +193,8 @@ Mapper::Mapper(const Intrinsics& K, const MapperOptions& options) : K_(K), optio
   if (!K.isValid()) throw Error("mapper: invalid camera intrinsics");
   if (const std::string problem = options.validate(); !problem.empty()) throw Error("mapper: " + problem);
   if (options.lens && options.lens->intrinsics != K) throw Error("mapper: lens: its intrinsics are not the camera's");
+  if (options.lens && !options.lens->distortion.isZero() && options.mode == MappingMode::Voxel)
+    raw_pixel_ = rawPixelOfEachPixel(*options.lens);
 }
 
 void Mapper::checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const {
@@ -180,6 +224,8 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
                                    const DepthImage* depth) {
   std::unique_lock lock(mutex_);
   checkKeyframe(pose, detections, depth);
+  std::optional<DepthImage> pinhole;  // a raw depth image of the lens, in the pinhole image
+  if (depth && !raw_pixel_.empty()) depth = &pinhole.emplace(pinholeDepth(*depth, raw_pixel_));
   KeyframeReport report;
   keyframe_poses_.push_back(pose);
   if (options_.mode == MappingMode::Voxel && options_.estimate_up_from_floor) {
@@ -190,10 +236,11 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
   }
   std::vector<Detection> ordered = inCanonicalOrder(detections);
   std::vector<bool> cut;  // by the raw image's border, for boxes undistorted from it
-  if (options_.lens && options_.mode == MappingMode::Boxes)
+  if (options_.lens)
     for (Detection& d : ordered) {
       cut.push_back(d.bbox.nearImageBorder(K_.width, K_.height, options_.boxes.border_px));
       d.bbox = options_.lens->undistortBox(d.bbox).value_or(Box());  // an empty box is ignored
+      if (d.mask && !raw_pixel_.empty()) d.mask = pinholeMask(*d.mask, raw_pixel_, *options_.lens);
     }
   if (options_.mode == MappingMode::Voxel)
     addVoxelKeyframe(pose, ordered, *depth, &report);

@@ -429,9 +429,6 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                                       "/keyframes.groundtruth.txt --detections " + d +
                                       "/keyframes.detections.json --out " + out},
       {"boxes map of frames without a pose", boxes_of_other_frames},
-      {"undistorted voxel map", "map --mode voxel --undistort --camera " + d + "/camera.yaml --trajectory " + d +
-                                    "/keyframes.groundtruth.txt --detections " + d +
-                                    "/keyframes.detections.json --out " + out},
       {"unknown preset", "simulate --preset mars --out " + dir.path("scene")},
       {"zero gravity", reloc + "--map " + d + "/map.json --detections " + d +
                            "/keyframes.detections.json --camera-up 0,0,0 --map-up 0,0,1"},

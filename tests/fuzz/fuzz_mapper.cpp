@@ -68,8 +68,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   MapperOptions options;
   options.mode = in.small(2) == 0 ? MappingMode::Voxel : MappingMode::Boxes;
   options.min_observations = 1 + in.small(3);
-  // Boxes of a raw image through a lens (any coefficients: one that folds over is refused).
-  if (options.mode == MappingMode::Boxes && in.small(3) == 0)
+  // Raw images through a lens (any coefficients: one that folds over is refused).
+  if (in.small(3) == 0)
     options.lens = Lens{K, {num(-0.5, 0.5), num(-0.5, 0.5), num(-0.01, 0.01), num(-0.01, 0.01), num(-0.5, 0.5)}};
   if (options.lens && !options.lens->whyNotUsable().empty()) return 0;
   Mapper mapper(K, options);

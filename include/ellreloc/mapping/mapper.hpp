@@ -60,10 +60,11 @@ struct MapperOptions {
   bool estimate_up_from_floor = false;
   FloorOptions floor;
   long min_mask_pixels = 30;  ///< smaller masks are ignored
-  /// Boxes mode: the keyframes' detections were made on the raw images of this distorted lens
-  /// (core/distortion.hpp): each box is undistorted to the pinhole image the ellipsoids project
-  /// into, and whether the image border cuts it is judged on the raw box. Its intrinsics must be
-  /// the mapper's. Voxel mode reads masks and depth images as pinhole images and refuses it.
+  /// The keyframes (detections, and depth images in voxel mode) are raw images of this distorted
+  /// lens (core/distortion.hpp): each box is undistorted to the pinhole image the ellipsoids
+  /// project into (whether the image border cuts it judged on the raw box), and each mask and
+  /// depth image resampled there (each pixel the nearest raw one). Its intrinsics must be the
+  /// mapper's.
   std::optional<Lens> lens;
 
   /// Empty when every field is finite and in range, else one line naming the first that is
@@ -171,6 +172,7 @@ class Mapper {
   std::vector<Pose> keyframe_poses_;  // for the map's camera envelope
   int next_id_ = 0;
   Eigen::Vector3d floor_normal_sum_ = Eigen::Vector3d::Zero();
+  std::vector<int> raw_pixel_;  // voxel mode through a lens: each pinhole pixel's raw pixel
 };
 
 }  // namespace ellreloc
