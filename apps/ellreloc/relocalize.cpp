@@ -371,18 +371,40 @@ std::vector<std::optional<Pose>> trackPoses(const RelocalizeArgs& a, const std::
 }
 
 /// Each frame's keypoints for --points: from the detections file itself, or from a file with the
-/// same frames; none without --points.
+/// same frames; none without --points. With a lens, moved to the pinhole image.
 std::vector<std::vector<Keypoint>> frameKeypoints(const RelocalizeArgs& a, const ObjectMap& map,
-                                                  const std::vector<DetectionFrame>& frames) {
+                                                  const std::vector<DetectionFrame>& frames,
+                                                  const std::optional<Lens>& lens) {
   std::vector<std::vector<Keypoint>> keypoints(frames.size());
   if (!a.use_points) return keypoints;
   if (map.points.empty()) throw Error(a.map + ": --points needs a map with `points`");
   std::map<std::string, std::vector<Keypoint>> by_name;
   if (!a.points.empty())
     for (const DetectionFrame& f : io::readDetections(a.points)) by_name[f.file_name] = f.keypoints;
-  for (size_t i = 0; i < frames.size(); ++i)
+  size_t left_out = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
     keypoints[i] = a.points.empty() ? frames[i].keypoints : by_name[frames[i].file_name];
+    if (lens) keypoints[i] = undistortKeypoints(*lens, keypoints[i], &left_out);
+  }
+  if (left_out > 0)
+    std::fprintf(stderr, "warning: %zu keypoint(s) left out: beyond where the lens's distortion can be undone\n",
+                 left_out);
   return keypoints;
+}
+
+/// How detections become observations: the policy, and with --undistort the camera file's lens.
+ObserveOptions observeOptions(const RelocalizeArgs& a, const std::string& policy, const Console& console) {
+  ObserveOptions o;
+  o.policy = parsePolicy(policy.empty() ? "solid" : policy);
+  if (a.undistort) {
+    o.lens = io::readLens(a.camera);
+    if (o.lens->distortion.isZero() && !console.quiet)
+      std::printf("%s: no distortion (Camera.k1 ... all 0 or left out): --undistort changes nothing\n",
+                  a.camera.c_str());
+  } else if (!console.quiet) {
+    mentionTheLens(a.camera);
+  }
+  return o;
 }
 
 /// One frame's entry of the --report JSON (with its diagnosis against a reference pose).
@@ -558,16 +580,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const std::vector<std::optional<PoseRegion>> regions = nearRegions(a, timestamps, &without_region);
   size_t without_odometry = 0;
   const std::vector<std::optional<Pose>> odometry = trackPoses(a, timestamps, &without_odometry);
-  ObserveOptions observe_options;
-  observe_options.policy = parsePolicy(policy.empty() ? "solid" : policy);
-  if (a.undistort) {
-    observe_options.lens = io::readLens(a.camera);
-    if (observe_options.lens->distortion.isZero() && !console.quiet)
-      std::printf("%s: no distortion (Camera.k1 ... all 0 or left out): --undistort changes nothing\n",
-                  a.camera.c_str());
-  } else if (!console.quiet) {
-    mentionTheLens(a.camera);
-  }
+  const ObserveOptions observe_options = observeOptions(a, policy, console);
   const ObjectRelocalizer relocalizer(object_map, K, options);
   if (const auto& up = relocalizer.upFromObjects(); up && !console.quiet)
     std::printf(
@@ -576,13 +589,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
         a.map.c_str(), relocalizer.options().envelope->max_roll_deg, up->up.x(), up->up.y(), up->up.z(), up->t,
         up->objects);
   const std::optional<GravityPrior> gravity = gravityPrior(a);
-  std::vector<std::vector<Keypoint>> keypoints = frameKeypoints(a, object_map, frames);
-  if (size_t left_out = 0; observe_options.lens) {
-    for (std::vector<Keypoint>& k : keypoints) k = undistortKeypoints(*observe_options.lens, k, &left_out);
-    if (left_out > 0)
-      std::fprintf(stderr, "warning: %zu keypoint(s) left out: beyond where the lens's distortion can be undone\n",
-                   left_out);
-  }
+  const std::vector<std::vector<Keypoint>> keypoints = frameKeypoints(a, object_map, frames, observe_options.lens);
   const std::vector<std::optional<Pose>> references = referencePoses(a, timestamps);
 
   if (!a.overlays.empty()) makeOverlayFolder(a.overlays);  // inputs read and checked: fail before the work
