@@ -22,9 +22,8 @@ void checkIntrinsics(const Intrinsics& K, const std::string& path) {
   if (!(K.width > 0) || !(K.height > 0)) throw Error(path + ": width and height must be positive");
 }
 
-Intrinsics readJson(const std::string& path) {
+Intrinsics intrinsicsFromJson(const detail::json& j, const std::string& path) {
   using namespace detail;
-  const json j = parseJson(readTextFile(path), path);
   const Where where{path, ""};
   Intrinsics K;
   K.fx = finiteNumber(member(j, "fx", where), where["fx"]);
@@ -86,8 +85,7 @@ std::map<std::string, std::string> yamlValues(const std::string& path) {
   return yamlTopLevel(text, path);
 }
 
-Intrinsics readYaml(const std::string& path) {
-  const std::map<std::string, std::string> values = yamlValues(path);
+Intrinsics intrinsicsFromYaml(const std::map<std::string, std::string>& values, const std::string& path) {
   Intrinsics K;
   K.fx = yamlNumber(values, "Camera.fx", path);
   K.fy = yamlNumber(values, "Camera.fy", path);
@@ -101,8 +99,7 @@ Intrinsics readYaml(const std::string& path) {
 /// The distortion keys, in the order of Distortion's fields; a key left out is 0.
 constexpr const char* kDistortionKeys[5] = {"k1", "k2", "p1", "p2", "k3"};
 
-Distortion readDistortionYaml(const std::string& path) {
-  const std::map<std::string, std::string> values = yamlValues(path);
+Distortion distortionFromYaml(const std::map<std::string, std::string>& values, const std::string& path) {
   double k[5] = {0, 0, 0, 0, 0};
   for (int i = 0; i < 5; ++i) {
     const std::string key = std::string("Camera.") + kDistortionKeys[i];
@@ -111,9 +108,8 @@ Distortion readDistortionYaml(const std::string& path) {
   return {k[0], k[1], k[2], k[3], k[4]};
 }
 
-Distortion readDistortionJson(const std::string& path) {
+Distortion distortionFromJson(const detail::json& j, const std::string& path) {
   using namespace detail;
-  const json j = parseJson(readTextFile(path), path);
   const Where where{path, ""};
   if (!j.is_object()) where.fail("expected an object");
   double k[5] = {0, 0, 0, 0, 0};
@@ -122,23 +118,40 @@ Distortion readDistortionJson(const std::string& path) {
   return {k[0], k[1], k[2], k[3], k[4]};
 }
 
+/// A camera file read and parsed once: its JSON document, or its YAML top-level values.
+struct CameraFile {
+  std::string path;
+  bool json = false;
+  detail::json document;
+  std::map<std::string, std::string> yaml;
+
+  explicit CameraFile(const std::string& p) : path(p), json(endsWith(p, ".json")) {
+    if (json)
+      document = detail::parseJson(readTextFile(path), path);
+    else
+      yaml = yamlValues(path);
+  }
+  Intrinsics intrinsics() const {
+    const Intrinsics K = json ? intrinsicsFromJson(document, path) : intrinsicsFromYaml(yaml, path);
+    checkIntrinsics(K, path);
+    return K;
+  }
+  Distortion distortion() const { return json ? distortionFromJson(document, path) : distortionFromYaml(yaml, path); }
+};
+
 }  // namespace
 
-Distortion readDistortion(const std::string& path) {
-  return endsWith(path, ".json") ? readDistortionJson(path) : readDistortionYaml(path);
-}
+Distortion readDistortion(const std::string& path) { return CameraFile(path).distortion(); }
 
 Lens readLens(const std::string& path) {
-  Lens lens{readCamera(path), readDistortion(path)};
+  const CameraFile file(path);
+  const Intrinsics K = file.intrinsics();  // the intrinsics' errors first
+  const Lens lens{K, file.distortion()};
   if (const std::string why = lens.whyNotUsable(); !why.empty()) throw Error(path + ": " + why);
   return lens;
 }
 
-Intrinsics readCamera(const std::string& path) {
-  const Intrinsics K = endsWith(path, ".json") ? readJson(path) : readYaml(path);
-  checkIntrinsics(K, path);
-  return K;
-}
+Intrinsics readCamera(const std::string& path) { return CameraFile(path).intrinsics(); }
 
 void writeCamera(const std::string& path, const Intrinsics& K) {
   if (!K.isValid()) throw Error(path + ": refusing to write invalid intrinsics");

@@ -185,7 +185,7 @@ ObserveResult observeDetection(const Detection& d, int width, int height, const 
     return r;
   }
   r = observeRaw(d, width, height, opt);
-  if (opt.lens && !opt.lens->distortion.isZero() && r.observation && !undistort(*opt.lens, &*r.observation)) {
+  if (opt.lens && r.observation && !undistort(*opt.lens, &*r.observation)) {
     r.status = ObserveStatus::InvalidBox;
     r.observation.reset();
     r.note = "the box reaches where the lens's distortion cannot be undone";
