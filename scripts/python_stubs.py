@@ -31,6 +31,7 @@ ARGUMENT_TYPES = {
     "depth": "ArrayLike | None",
     "path": "str | os.PathLike[str]",
     "dir": "str | os.PathLike[str]",
+    "rgb_path": "str | os.PathLike[str]",
     "policy": "str | ObservationPolicy | None",
     "mode": "str | MappingMode | None",
     "preset": "str | ScenePreset",

@@ -4,7 +4,6 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -23,8 +22,6 @@ namespace fs = std::filesystem;
 namespace ellreloc::cli {
 
 namespace {
-
-std::string absoluteNormal(const fs::path& p) { return fs::absolute(p).lexically_normal().string(); }
 
 /// The frames that have a pose in the trajectory, with that pose; with a lens, their boxes
 /// undistorted (one that cannot be, far outside the image, is left out).
@@ -150,6 +147,7 @@ void map(const MapArgs& a, const Console& console) {
     throw Error(a.associations.empty() ? std::string("--associations: voxel mode needs the depth images")
                                        : a.associations + ": no association");
   const fs::path detections_dir = fs::path(a.detections).parent_path();
+  const io::AssociationIndex association_of(associations);
 
   Mapper mapper(K, options);
   std::vector<PosedDetections> held_out;
@@ -162,15 +160,9 @@ void map(const MapArgs& a, const Console& console) {
       held_out.insert(held_out.end(), one.begin(), one.end());
       continue;
     }
-    // The frame's depth: the association naming the same colour image, else the same time.
-    const std::string rgb = absoluteNormal(detections_dir / f.file_name);
-    const io::Association* assoc = nullptr;
-    for (const io::Association& as : associations)
-      if (absoluteNormal(as.rgb_path) == rgb) assoc = &as;
+    // The frame's depth: the association naming the same colour image, else the nearest time.
+    const io::Association* assoc = association_of.find((detections_dir / f.file_name).string(), f.timestamp());
     const std::optional<double> t = assoc ? std::optional<double>(assoc->rgb_time) : f.timestamp();
-    if (!assoc && t)
-      for (const io::Association& as : associations)
-        if (std::abs(as.rgb_time - *t) <= 0.02) assoc = &as;
     const std::optional<size_t> k = t ? io::findNearest(trajectory, *t) : std::nullopt;
     if (!k) {
       ++no_pose;

@@ -26,6 +26,12 @@ class Association:
     depth_path: str
 
 
+class AssociationIndex:
+    """Finds a colour image's line of an association file: the line naming it, else the one nearest in time within `tolerance` seconds (what `ellreloc map` does)."""
+    def __init__(self, associations: list[Association], tolerance: float = ...) -> None: ...
+    def find(self, rgb_path: str | os.PathLike[str], rgb_time: Optional[float] = ...) -> Optional[Association]: """The association of a colour image (its path, and its time when known); None when there is none."""
+
+
 class Box:
     """An axis-aligned box in pixels: corners (x1, y1) and (x2, y2), x2 > x1, y2 > y1."""
     @overload

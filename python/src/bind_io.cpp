@@ -143,6 +143,18 @@ void bindFiles(py::module_& m) {
   m.def(
       "read_associations", [](const py::handle& path) { return io::readAssociations(pathFrom(path)); }, py::arg("path"),
       "A TUM association file; paths resolved against the file's folder.");
+  py::class_<io::AssociationIndex>(m, "AssociationIndex",
+                                   "Finds a colour image's line of an association file: the line naming it, else "
+                                   "the one nearest in time within `tolerance` seconds (what `ellreloc map` does).")
+      .def(py::init<std::vector<io::Association>, double>(), py::arg("associations"), py::arg("tolerance") = 0.02)
+      .def(
+          "find",
+          [](const io::AssociationIndex& index, const py::handle& rgb_path, std::optional<double> rgb_time) {
+            const io::Association* a = index.find(pathFrom(rgb_path), rgb_time);
+            return a ? std::optional<io::Association>(*a) : std::nullopt;
+          },
+          py::arg("rgb_path"), py::arg("rgb_time") = py::none(),
+          "The association of a colour image (its path, and its time when known); None when there is none.");
 }
 
 }  // namespace

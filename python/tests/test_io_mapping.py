@@ -1,6 +1,5 @@
 """Files and mapping from Python: round trips, errors as exceptions, maps equal to the command line's."""
 
-import os
 import subprocess
 import warnings
 
@@ -80,12 +79,22 @@ def test_depth_pngs(data_dir):
     assert np.abs(units - np.round(units)).max() < 1e-3 and 0.3 < np.median(depth[depth > 0]) < 8
 
 
+def test_association_index(tmp_path):
+    (tmp_path / "a.txt").write_text("1.000 rgb/a.png 1.001 depth/a.png\n1.033 rgb/b.png 1.034 depth/b.png\n")
+    index = E.AssociationIndex(E.read_associations(tmp_path / "a.txt"))
+    assert index.find(tmp_path / "rgb" / "b.png").depth_path.endswith("depth/b.png")  # by name
+    assert index.find(tmp_path / "rgb" / "x.png", 1.012).depth_path.endswith("depth/a.png")  # nearest in time
+    assert index.find(tmp_path / "rgb" / "x.png", 1.021).depth_path.endswith("depth/b.png")
+    assert index.find(tmp_path / "rgb" / "x.png", 1.2) is None and index.find("x.png") is None
+    assert E.AssociationIndex(E.read_associations(tmp_path / "a.txt"), tolerance=0.001).find("x.png", 1.012) is None
+
+
 def mapping_inputs(folder):
     """What `ellreloc map` pairs up for each frame: its pose and depth file (same colour image)."""
     trajectory = E.read_trajectory(folder / "trajectory.txt")
-    associations = {os.path.normpath(a.rgb_path): a for a in E.read_associations(folder / "associations.txt")}
+    associations = E.AssociationIndex(E.read_associations(folder / "associations.txt"))
     for frame in E.read_detections(folder / "detections.json"):
-        a = associations[os.path.normpath(str(folder / frame.file_name))]
+        a = associations.find(folder / frame.file_name, frame.timestamp)
         yield trajectory[E.find_nearest(trajectory, a.rgb_time)].pose, frame.detections, a.depth_path
 
 

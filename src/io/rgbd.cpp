@@ -1,7 +1,10 @@
 #include "ellreloc/io/rgbd.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <iterator>
 #include <sstream>
 
 #include "ellreloc/error.hpp"
@@ -11,6 +14,10 @@
 namespace ellreloc::io {
 
 namespace {
+
+std::string absoluteNormal(const std::string& path) {
+  return std::filesystem::absolute(path).lexically_normal().string();
+}
 
 std::string folderOf(const std::string& path) {
   const size_t slash = path.find_last_of('/');
@@ -38,6 +45,33 @@ std::vector<Association> readAssociations(const std::string& path) {
   });
   if (out.empty()) throw Error(path + ": no associations found (empty file)");
   return out;
+}
+
+AssociationIndex::AssociationIndex(std::vector<Association> associations, double tolerance)
+    : associations_(std::move(associations)), tolerance_(tolerance) {
+  for (size_t k = 0; k < associations_.size(); ++k) {
+    by_image_[absoluteNormal(associations_[k].rgb_path)] = k;
+    by_time_.emplace_back(associations_[k].rgb_time, k);
+  }
+  std::sort(by_time_.begin(), by_time_.end());
+}
+
+const Association* AssociationIndex::find(const std::string& rgb_path, std::optional<double> rgb_time) const {
+  if (associations_.empty()) return nullptr;
+  if (const auto named = by_image_.find(absoluteNormal(rgb_path)); named != by_image_.end())
+    return &associations_[named->second];
+  if (!rgb_time || !std::isfinite(*rgb_time)) return nullptr;
+  // The nearest time is the first at or after it, or the one before.
+  const auto after = std::lower_bound(by_time_.begin(), by_time_.end(), std::make_pair(*rgb_time, size_t{0}));
+  const Association* nearest = nullptr;
+  double nearest_dt = tolerance_;
+  if (after != by_time_.begin()) {
+    const auto before = std::prev(after);
+    if (*rgb_time - before->first <= nearest_dt)
+      nearest = &associations_[before->second], nearest_dt = *rgb_time - before->first;
+  }
+  if (after != by_time_.end() && after->first - *rgb_time <= nearest_dt) nearest = &associations_[after->second];
+  return nearest;
 }
 
 DepthImage readDepthPng(const std::string& path, double units_per_metre) {

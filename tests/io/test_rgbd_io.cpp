@@ -1,12 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
-#include "fixtures/data_dir.hpp"
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
 #include "ellreloc/io/rgbd.hpp"
+#include "fixtures/data_dir.hpp"
 #include "fixtures/temp_dir.hpp"
 
 using namespace ellreloc;
@@ -67,4 +68,43 @@ TEST(RgbdIo, DepthRoundTripAndErrors) {
   EXPECT_THROW(io::readAssociations(dir.path("a.txt")), Error);
   io::writeFileAtomically(dir.path("b.txt"), "# nothing\n");
   EXPECT_THROW(io::readAssociations(dir.path("b.txt")), Error);
+}
+
+TEST(RgbdIo, AssociationIndexFindsTheNamedImageElseTheNearestTime) {
+  test::TempDir dir;
+  // Colour images 33 ms apart; the third is named twice (the last line counts).
+  io::writeFileAtomically(dir.path("associate.txt"),
+                          "10.000 rgb/a.png 10.001 depth/a.png\n"
+                          "10.033 rgb/b.png 10.034 depth/b.png\n"
+                          "10.066 rgb/c.png 10.067 depth/c1.png\n"
+                          "10.300 rgb/c.png 10.301 depth/c2.png\n");
+  const std::vector<io::Association> lines = io::readAssociations(dir.path("associate.txt"));
+  const io::AssociationIndex index(lines);
+  const auto depthOf = [&](const std::string& rgb, std::optional<double> t) -> std::string {
+    const io::Association* a = index.find(rgb, t);
+    return a ? std::filesystem::path(a->depth_path).filename().string() : "none";
+  };
+  // By name, however the path is spelt, whatever the time says.
+  EXPECT_EQ(depthOf(dir.path("rgb/b.png"), 10.0), "b.png");
+  EXPECT_EQ(depthOf(dir.path("rgb/../rgb/./b.png"), std::nullopt), "b.png");
+  EXPECT_EQ(depthOf(dir.path("rgb/c.png"), std::nullopt), "c2.png");
+  // Else by time: the nearest line within 0.02 s, on either side of it.
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), 10.020), "b.png");  // 13 ms to b, 20 ms to a
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), 10.013), "a.png");  // 13 ms to a, 20 ms to b
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), 10.3199), "c2.png");
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), 9.9), "none");   // before every line
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), 10.2), "none");  // between lines, 0.13 s from both
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), 11.0), "none");  // after every line
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), std::nullopt), "none");
+  EXPECT_EQ(depthOf(dir.path("rgb/x.png"), std::nan("")), "none");
+  // The same as reading every line for the nearest, at times over the whole sequence.
+  for (double t = 9.95; t < 10.36; t += 0.0007) {
+    std::string expected = "none";
+    double best = 0.02;
+    for (const io::Association& a : lines)
+      if (std::abs(a.rgb_time - t) <= best)
+        best = std::abs(a.rgb_time - t), expected = std::filesystem::path(a.depth_path).filename().string();
+    EXPECT_EQ(depthOf(dir.path("rgb/x.png"), t), expected) << t;
+  }
+  EXPECT_EQ(io::AssociationIndex({}).find(dir.path("rgb/a.png"), 10.0), nullptr);
 }

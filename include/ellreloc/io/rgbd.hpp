@@ -4,7 +4,10 @@
 /// depth PNGs with 5000 units per metre (0 = no reading).
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "ellreloc/core/depth_image.hpp"
@@ -21,6 +24,23 @@ struct Association {
 /// Reads an association file; relative paths are made relative to the file's own folder.
 /// `#` starts a comment. Throws ellreloc::Error naming the file and line on malformed input.
 std::vector<Association> readAssociations(const std::string& path);
+
+/// Each colour image's association in a sequence: the line naming the same image (paths
+/// compared made absolute and normalised; of several, the last), else the line whose colour
+/// image is nearest in time within `tolerance` seconds. Indexed once, so that each of thousands
+/// of frames is found without reading every line.
+class AssociationIndex {
+ public:
+  explicit AssociationIndex(std::vector<Association> associations, double tolerance = 0.02);
+  /// nullptr when no line names the image and none is within the tolerance of `rgb_time`.
+  const Association* find(const std::string& rgb_path, std::optional<double> rgb_time) const;
+
+ private:
+  std::vector<Association> associations_;
+  double tolerance_;
+  std::unordered_map<std::string, size_t> by_image_;
+  std::vector<std::pair<double, size_t>> by_time_;  // sorted
+};
 
 /// TUM's scale: 5000 depth units per metre.
 constexpr double kTumDepthUnitsPerMetre = 5000.0;
