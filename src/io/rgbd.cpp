@@ -49,6 +49,8 @@ std::vector<Association> readAssociations(const std::string& path) {
 
 AssociationIndex::AssociationIndex(std::vector<Association> associations, double tolerance)
     : associations_(std::move(associations)), tolerance_(tolerance) {
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
+    throw Error("association index: the time tolerance must be finite and >= 0, got " + std::to_string(tolerance));
   for (size_t k = 0; k < associations_.size(); ++k) {
     by_image_[absoluteNormal(associations_[k].rgb_path)] = k;
     by_time_.emplace_back(associations_[k].rgb_time, k);

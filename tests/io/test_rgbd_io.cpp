@@ -107,4 +107,7 @@ TEST(RgbdIo, AssociationIndexFindsTheNamedImageElseTheNearestTime) {
     EXPECT_EQ(depthOf(dir.path("rgb/x.png"), t), expected) << t;
   }
   EXPECT_EQ(io::AssociationIndex({}).find(dir.path("rgb/a.png"), 10.0), nullptr);
+  EXPECT_THROW(io::AssociationIndex(lines, -0.01), Error);
+  EXPECT_THROW(io::AssociationIndex(lines, std::nan("")), Error);
+  EXPECT_THROW(io::AssociationIndex(lines, INFINITY), Error);
 }

@@ -31,6 +31,7 @@ std::vector<Association> readAssociations(const std::string& path);
 /// of frames is found without reading every line.
 class AssociationIndex {
  public:
+  /// Throws ellreloc::Error for a tolerance that is negative or not finite.
   explicit AssociationIndex(std::vector<Association> associations, double tolerance = 0.02);
   /// nullptr when no line names the image and none is within the tolerance of `rgb_time`.
   const Association* find(const std::string& rgb_path, std::optional<double> rgb_time) const;
