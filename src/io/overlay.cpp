@@ -1,6 +1,8 @@
 #include "ellreloc/io/overlay.hpp"
 
 #include <cstdio>
+#include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -41,17 +43,41 @@ std::vector<std::optional<Ellipse>> projectMap(const ObjectMap& map, const Intri
   return out;
 }
 
+/// Where each pinhole pixel of a lens's image lies in the raw image.
+struct LensRemap {
+  Lens lens;
+  cv::Mat map_x, map_y;
+};
+
+/// The remap of `lens` over a rows x cols image. The pictures of a sequence share one lens, and
+/// a 640x480 map costs several milliseconds, as much as the rest of a picture: the last one made
+/// is kept for the next picture (shared between threads, so one being drawn keeps its own).
+std::shared_ptr<const LensRemap> remapOf(const Lens& lens, int rows, int cols) {
+  static std::mutex mutex;
+  static std::shared_ptr<const LensRemap> last;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (last && last->lens.intrinsics == lens.intrinsics && last->lens.distortion == lens.distortion &&
+      last->map_x.rows == rows && last->map_x.cols == cols)
+    return last;
+  auto made = std::make_shared<LensRemap>();
+  made->lens = lens;
+  made->map_x.create(rows, cols, CV_32FC1);
+  made->map_y.create(rows, cols, CV_32FC1);
+  for (int y = 0; y < rows; ++y)
+    for (int x = 0; x < cols; ++x) {
+      const Eigen::Vector2d p = lens.distortion.distortPixel(lens.intrinsics, {x, y});
+      made->map_x.at<float>(y, x) = static_cast<float>(p.x());
+      made->map_y.at<float>(y, x) = static_cast<float>(p.y());
+    }
+  last = made;
+  return last;
+}
+
 /// The raw image resampled as the pinhole camera of the same intrinsics sees it.
 cv::Mat undistorted(const cv::Mat& raw, const Lens& lens) {
-  cv::Mat map_x(raw.rows, raw.cols, CV_32FC1), map_y(raw.rows, raw.cols, CV_32FC1);
-  for (int y = 0; y < raw.rows; ++y)
-    for (int x = 0; x < raw.cols; ++x) {
-      const Eigen::Vector2d p = lens.distortion.distortPixel(lens.intrinsics, {x, y});
-      map_x.at<float>(y, x) = static_cast<float>(p.x());
-      map_y.at<float>(y, x) = static_cast<float>(p.y());
-    }
+  const std::shared_ptr<const LensRemap> remap = remapOf(lens, raw.rows, raw.cols);
   cv::Mat out;
-  cv::remap(raw, out, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
+  cv::remap(raw, out, remap->map_x, remap->map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
   return out;
 }
 

@@ -176,6 +176,13 @@ TEST(Overlays, ARawBackgroundIsUndistortedWithTheLens) {
   EXPECT_GT((expected - Eigen::Vector2d(60, 50)).norm(), 5.0);
   EXPECT_LT((spot(&lens) - expected).norm(), 1.0);
   EXPECT_LT((spot(nullptr) - Eigen::Vector2d(60, 50)).norm(), 0.5);
+  // The resampling is kept from one picture to the next of the same lens: another lens between
+  // two pictures of the first gets its own, and the first its own again.
+  const Lens milder{K, {0.1, -0.2, 0.0, 0.0, 0.1}};
+  const Eigen::Vector2d expected_milder = *milder.undistortPixel({60.0, 50.0});
+  EXPECT_GT((expected_milder - expected).norm(), 3.0);
+  EXPECT_LT((spot(&milder) - expected_milder).norm(), 1.0);
+  EXPECT_LT((spot(&lens) - expected).norm(), 1.0);
 }
 
 TEST_F(Pictures, ComparisonPlotsAndPerFrameCsvCoverEveryMethodAndFrame) {

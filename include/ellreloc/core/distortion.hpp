@@ -26,6 +26,10 @@ struct Distortion {
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
 
   bool isZero() const { return k1 == 0 && k2 == 0 && p1 == 0 && p2 == 0 && k3 == 0; }
+  bool operator==(const Distortion& o) const {
+    return k1 == o.k1 && k2 == o.k2 && p1 == o.p1 && p2 == o.p2 && k3 == o.k3;
+  }
+  bool operator!=(const Distortion& o) const { return !(*this == o); }
   bool isFinite() const {
     return std::isfinite(k1) && std::isfinite(k2) && std::isfinite(p1) && std::isfinite(p2) && std::isfinite(k3);
   }
