@@ -86,6 +86,7 @@ def test_association_index(tmp_path):
     assert index.find(tmp_path / "rgb" / "x.png", 1.012).depth_path.endswith("depth/a.png")  # nearest in time
     assert index.find(tmp_path / "rgb" / "x.png", 1.021).depth_path.endswith("depth/b.png")
     assert index.find(tmp_path / "rgb" / "x.png", 1.2) is None and index.find("x.png") is None
+    assert index.find("") is None and index.find("", 1.0).depth_path.endswith("depth/a.png")
     assert E.AssociationIndex(E.read_associations(tmp_path / "a.txt"), tolerance=0.001).find("x.png", 1.012) is None
     with pytest.raises(ValueError, match="tolerance"):
         E.AssociationIndex([], tolerance=-1.0)

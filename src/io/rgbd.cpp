@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iterator>
 #include <sstream>
+#include <system_error>
 
 #include "ellreloc/error.hpp"
 #include "ellreloc/io/files.hpp"
@@ -15,8 +16,11 @@ namespace ellreloc::io {
 
 namespace {
 
+/// The path made absolute (as given when it cannot be: empty, or no current directory) and normalised.
 std::string absoluteNormal(const std::string& path) {
-  return std::filesystem::absolute(path).lexically_normal().string();
+  std::error_code error;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, error);
+  return (error ? std::filesystem::path(path) : absolute).lexically_normal().string();
 }
 
 std::string folderOf(const std::string& path) {

@@ -1,4 +1,5 @@
 // The readers that take paths: camera YAML and JSON, TUM trajectories, association files.
+#include <algorithm>
 #include <cmath>
 
 #include "ellreloc/error.hpp"
@@ -42,7 +43,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const Error&) {
   }
   try {
-    (void)io::readAssociations(txt);
+    // Each line is found by its colour image (that line or a later one naming the same image),
+    // and by its time alone the line nearest in time, as reading every line finds it.
+    const std::vector<io::Association> lines = io::readAssociations(txt);
+    const io::AssociationIndex index(lines);
+    for (const io::Association& a : lines) {
+      const io::Association* named = index.find(a.rgb_path, std::nullopt);
+      FUZZ_CHECK(named && named->rgb_path == a.rgb_path);
+      const double t = a.rgb_time + 0.007;  // within the 0.02 s tolerance of this line at least
+      double nearest = INFINITY;
+      for (const io::Association& b : lines) nearest = std::min(nearest, std::abs(b.rgb_time - t));
+      const io::Association* timed = index.find("/no such image", t);
+      FUZZ_CHECK(nearest > 0.02 || (timed && std::abs(timed->rgb_time - t) == nearest));
+    }
   } catch (const Error&) {
   }
   return 0;

@@ -97,6 +97,8 @@ TEST(RgbdIo, AssociationIndexFindsTheNamedImageElseTheNearestTime) {
   EXPECT_EQ(depthOf(dir.path("rgb/x.png"), 11.0), "none");  // after every line
   EXPECT_EQ(depthOf(dir.path("rgb/x.png"), std::nullopt), "none");
   EXPECT_EQ(depthOf(dir.path("rgb/x.png"), std::nan("")), "none");
+  EXPECT_EQ(depthOf("", std::nullopt), "none");  // no image named, no exception
+  EXPECT_EQ(depthOf("", 10.0), "a.png");
   // The same as reading every line for the nearest, at times over the whole sequence.
   for (double t = 9.95; t < 10.36; t += 0.0007) {
     std::string expected = "none";
