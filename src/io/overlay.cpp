@@ -56,9 +56,7 @@ std::shared_ptr<const LensRemap> remapOf(const Lens& lens, int rows, int cols) {
   static std::mutex mutex;
   static std::shared_ptr<const LensRemap> last;
   const std::lock_guard<std::mutex> lock(mutex);
-  if (last && last->lens.intrinsics == lens.intrinsics && last->lens.distortion == lens.distortion &&
-      last->map_x.rows == rows && last->map_x.cols == cols)
-    return last;
+  if (last && last->lens == lens && last->map_x.rows == rows && last->map_x.cols == cols) return last;
   auto made = std::make_shared<LensRemap>();
   made->lens = lens;
   made->map_x.create(rows, cols, CV_32FC1);

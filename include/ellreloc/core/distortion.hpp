@@ -20,6 +20,18 @@
 
 namespace ellreloc {
 
+namespace detail {
+
+/// The normalised coordinates ((u - cx) / fx, (v - cy) / fy) of a pixel, and back.
+inline Eigen::Vector2d normalisedOf(const Intrinsics& K, const Eigen::Vector2d& uv) {
+  return {(uv(0) - K.cx) / K.fx, (uv(1) - K.cy) / K.fy};
+}
+inline Eigen::Vector2d pixelOf(const Intrinsics& K, const Eigen::Vector2d& x) {
+  return {K.fx * x(0) + K.cx, K.fy * x(1) + K.cy};
+}
+
+}  // namespace detail
+
 /// x_d = x (1 + k1 r^2 + k2 r^4 + k3 r^6) + [2 p1 x y + p2 (r^2 + 2 x^2), p1 (r^2 + 2 y^2) + 2 p2 x y]
 /// on normalised coordinates x = ((u - cx) / fx, (v - cy) / fy), r = |x|.
 struct Distortion {
@@ -71,8 +83,7 @@ struct Distortion {
 
   /// The pixel of a raw image where the undistorted image's pixel `uv` was taken.
   Eigen::Vector2d distortPixel(const Intrinsics& K, const Eigen::Vector2d& uv) const {
-    const Eigen::Vector2d xd = distort({(uv(0) - K.cx) / K.fx, (uv(1) - K.cy) / K.fy});
-    return {K.fx * xd(0) + K.cx, K.fy * xd(1) + K.cy};
+    return detail::pixelOf(K, distort(detail::normalisedOf(K, uv)));
   }
 
   /// The undistorted image's pixel of a raw image's pixel `uv`; nullopt where undistort() is.
@@ -80,10 +91,10 @@ struct Distortion {
   std::optional<Eigen::Vector2d> undistortPixel(const Intrinsics& K, const Eigen::Vector2d& uv,
                                                 const std::optional<Eigen::Vector2d>& near = std::nullopt) const {
     std::optional<Eigen::Vector2d> start;
-    if (near) start = Eigen::Vector2d(((*near)(0) - K.cx) / K.fx, ((*near)(1) - K.cy) / K.fy);
-    const std::optional<Eigen::Vector2d> x = undistort({(uv(0) - K.cx) / K.fx, (uv(1) - K.cy) / K.fy}, start);
+    if (near) start = detail::normalisedOf(K, *near);
+    const std::optional<Eigen::Vector2d> x = undistort(detail::normalisedOf(K, uv), start);
     if (!x) return std::nullopt;
-    return Eigen::Vector2d(K.fx * (*x)(0) + K.cx, K.fy * (*x)(1) + K.cy);
+    return detail::pixelOf(K, *x);
   }
 
   /// Why the model cannot be undone over a width x height image of intrinsics K, or "" when it
@@ -95,8 +106,10 @@ struct Distortion {
     if (!K.isValid()) return "invalid intrinsics";
     double corner_radius = 0.0;  // the farthest corner, in distorted normalised coordinates
     for (const double u : {-0.5, K.width - 0.5})
-      for (const double v : {-0.5, K.height - 0.5})
-        corner_radius = std::max(corner_radius, std::hypot((u - K.cx) / K.fx, (v - K.cy) / K.fy));
+      for (const double v : {-0.5, K.height - 0.5}) {
+        const Eigen::Vector2d corner = detail::normalisedOf(K, {u, v});
+        corner_radius = std::max(corner_radius, std::hypot(corner(0), corner(1)));
+      }
     // Walk out along r until the distorted radius passes the corner's (the tangential terms,
     // small beside the radial ones, are left to undistort(), which checks every point).
     const double step = corner_radius / 256.0;
@@ -118,6 +131,8 @@ struct Distortion {
 struct Lens {
   Intrinsics intrinsics;
   Distortion distortion;
+
+  bool operator==(const Lens& o) const { return intrinsics == o.intrinsics && distortion == o.distortion; }
 
   /// Why the lens cannot be undone over its image, or "" (Distortion::whyNotInvertible).
   std::string whyNotUsable() const { return distortion.whyNotInvertible(intrinsics); }
