@@ -37,7 +37,8 @@ struct NamedPath {
 
 /// Before any work: refuses (Error) an output that is the same file as an input or another
 /// output (same device and inode, or the same resolved path when it does not exist yet), or
-/// that exists and is not a regular file. Empty paths are skipped.
+/// that exists and is not a regular file, or whose folder does not exist or cannot be written.
+/// Empty paths are skipped.
 void checkPaths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
 
 /// For a command run without --undistort: says so when the camera file gives a lens distortion

@@ -56,6 +56,15 @@ void checkPaths(const std::vector<NamedPath>& outputs, const std::vector<NamedPa
     struct stat st {};
     if (::stat(out.path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
       throw Error(out.option + ": '" + out.path + "' exists and is not a regular file (a directory, device or FIFO)");
+    // The folder must exist and take files now: a long run should not end in an error it could
+    // have given before its work.
+    const std::filesystem::path parent = std::filesystem::path(out.path).parent_path();
+    const std::string folder = parent.empty() ? "." : parent.string();
+    if (::stat(folder.c_str(), &st) != 0)
+      throw Error(out.option + ": '" + out.path + "': the folder '" + folder + "' does not exist");
+    if (!S_ISDIR(st.st_mode)) throw Error(out.option + ": '" + out.path + "': '" + folder + "' is not a folder");
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+      throw Error(out.option + ": '" + out.path + "': cannot write into the folder '" + folder + "'");
     const std::string id = fileIdentity(out.path);
     for (const auto& [other_id, other] : seen)
       if (other_id == id)

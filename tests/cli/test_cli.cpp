@@ -342,6 +342,13 @@ TEST(Cli, OutputsNeverClobberInputsAndOnlyRegularFilesAreRead) {
       {"--report is --out", reloc + "--map " + map + " --detections " + detections + " --out " + dir.path("p.txt") +
                                 " --report " + dir.path("./p.txt")},
       {"--out is a directory", reloc + "--map " + map + " --detections " + detections + " --out " + dir.path("folder")},
+      {"--out in a missing folder",
+       reloc + "--map " + map + " --detections " + detections + " --out " + dir.path("missing/x.txt")},
+      {"--report under a file", reloc + "--map " + map + " --detections " + detections + " --out " + dir.path("x.txt") +
+                                    " --report " + map + "/report.json"},
+      {"map --out in a missing folder", "map --mode boxes --camera " + d + "/camera.yaml --trajectory " + d +
+                                            "/keyframes.groundtruth.txt --detections " + detections + " --out " +
+                                            dir.path("missing/map.json")},
       {"observe --out is --detections",
        "observe --camera " + d + "/camera.yaml --detections " + detections + " --out " + detections},
       {"--detections is a device", reloc + "--map " + map + " --detections /dev/zero --out " + dir.path("x.txt")},
@@ -352,6 +359,7 @@ TEST(Cli, OutputsNeverClobberInputsAndOnlyRegularFilesAreRead) {
     const CliRun r = run(args, dir);
     EXPECT_EQ(r.code, 2) << name << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1) << name << ": " << r.err;
+    EXPECT_EQ(r.out, "") << name << ": refused only after starting the work";
   }
   EXPECT_EQ(readFile(detections), before_detections);
   EXPECT_EQ(readFile(map), before_map);
