@@ -10,6 +10,30 @@ namespace ellreloc {
 
 namespace {
 
+/// interpolatedQuantile(values, low) and (values, high) from one copy of `values` in
+/// `scratch` (reordered): the yaw search below takes thousands of them per object.
+std::pair<double, double> quantilePair(const std::vector<double>& values, double low, double high,
+                                       std::vector<double>* scratch) {
+  if (values.empty()) return {0.0, 0.0};
+  std::vector<double>& v = *scratch;
+  v.assign(values.begin(), values.end());
+  const double last = static_cast<double>(v.size() - 1);
+  // The q-quantile interpolates between the k-th and (k+1)-th smallest values, k = floor(q (n - 1)).
+  const auto at = [&](double q, size_t from) {
+    const double pos = std::clamp(q, 0.0, 1.0) * last;
+    const size_t k = static_cast<size_t>(pos);
+    std::nth_element(v.begin() + static_cast<long>(from), v.begin() + static_cast<long>(k), v.end());
+    if (k + 1 >= v.size()) return std::make_pair(v[k], k);
+    const double next = *std::min_element(v.begin() + static_cast<long>(k) + 1, v.end());
+    return std::make_pair(v[k] + (pos - static_cast<double>(k)) * (next - v[k]), k);
+  };
+  const auto [q_low, k_low] = at(low, 0);
+  // Everything after the low quantile's k-th value is at least it: a higher quantile's k-th
+  // value is among them.
+  const bool higher = std::clamp(high, 0.0, 1.0) >= std::clamp(low, 0.0, 1.0);
+  return {q_low, at(high, higher ? k_low : 0).first};
+}
+
 /// The percentile rectangle of ground-plane points along `main` and across it (lo, hi in
 /// (along, across) coordinates); `along` and `across` receive every point's coordinates.
 void percentileRectangle(const std::vector<Eigen::Vector2d>& ground, const Eigen::Vector2d& main, double low,
@@ -19,8 +43,11 @@ void percentileRectangle(const std::vector<Eigen::Vector2d>& ground, const Eigen
   along->resize(ground.size());
   across->resize(ground.size());
   for (size_t i = 0; i < ground.size(); ++i) (*along)[i] = main.dot(ground[i]), (*across)[i] = side.dot(ground[i]);
-  *lo = Eigen::Vector2d(interpolatedQuantile(*along, low), interpolatedQuantile(*across, low));
-  *hi = Eigen::Vector2d(interpolatedQuantile(*along, high), interpolatedQuantile(*across, high));
+  thread_local std::vector<double> scratch;
+  const auto [along_lo, along_hi] = quantilePair(*along, low, high, &scratch);
+  const auto [across_lo, across_hi] = quantilePair(*across, low, high, &scratch);
+  *lo = Eigen::Vector2d(along_lo, across_lo);
+  *hi = Eigen::Vector2d(along_hi, across_hi);
 }
 
 /// The direction of the longer side of the smallest percentile rectangle of 2D points (the

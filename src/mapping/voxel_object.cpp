@@ -108,9 +108,10 @@ void VoxelObject::addToMean(Voxel& v, const Eigen::Vector3d& offset, long count)
   v.points = static_cast<uint16_t>(total);
 }
 
-bool VoxelObject::occupied(const Voxel& v) const {
-  return v.log_odds >= static_cast<float>(logit(options_.occupied_probability));
-}
+VoxelObject::VoxelObject(const VoxelOptions& options)
+    : options_(options), occupied_log_odds_(static_cast<float>(logit(options.occupied_probability))) {}
+
+bool VoxelObject::occupied(const Voxel& v) const { return v.log_odds >= occupied_log_odds_; }
 
 VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const DepthImage& depth,
                                    const BinaryMask& raw_mask) {

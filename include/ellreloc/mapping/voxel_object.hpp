@@ -63,7 +63,7 @@ struct VoxelUpdate {
 
 class VoxelObject {
  public:
-  explicit VoxelObject(const VoxelOptions& options = {}) : options_(options) {}
+  explicit VoxelObject(const VoxelOptions& options = {});
 
   /// Integrates one keyframe: world->camera `pose`, its depth image, and the object's mask in
   /// that image (a full-image mask or a crop). Throws ellreloc::Error when the intrinsics,
@@ -146,6 +146,7 @@ class VoxelObject {
     }
   };
   VoxelOptions options_;
+  float occupied_log_odds_;  // of options_.occupied_probability: occupied() runs once per voxel
   std::unordered_map<uint64_t, Voxel, KeyHash> voxels_;
   uint32_t frames_ = 0;
 };
