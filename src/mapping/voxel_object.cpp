@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <unordered_map>
 
@@ -16,6 +17,15 @@ constexpr int kKeyOffset = 1 << (kKeyBits - 1);  // keys span [-2^20, 2^20) voxe
 constexpr uint64_t kKeyMask = (uint64_t{1} << kKeyBits) - 1;
 
 double logit(double p) { return std::log(p / (1.0 - p)); }
+
+/// The splitmix64 finaliser: packed keys are far from random, their low bits nearly constant.
+uint64_t hashOf(uint64_t k) {
+  k ^= k >> 30;
+  k *= 0xbf58476d1ce4e5b9ULL;
+  k ^= k >> 27;
+  k *= 0x94d049bb133111ebULL;
+  return k ^ (k >> 31);
+}
 
 bool inMask(const BinaryMask& mask, int x, int y) {
   const int lx = x - mask.x0, ly = y - mask.y0;
@@ -113,6 +123,61 @@ VoxelObject::VoxelObject(const VoxelOptions& options)
 
 bool VoxelObject::occupied(const Voxel& v) const { return v.log_odds >= occupied_log_odds_; }
 
+long VoxelObject::indexOf(uint64_t key) const {
+  if (slots_.empty()) return -1;
+  const size_t mask = slots_.size() - 1;
+  for (size_t s = hashOf(key) & mask;; s = (s + 1) & mask) {
+    const uint32_t slot = slots_[s];
+    if (slot == 0) return -1;
+    if (keys_[slot - 1] == key) return static_cast<long>(slot - 1);
+  }
+}
+
+size_t VoxelObject::indexOrAdd(uint64_t key, bool* added) {
+  if (2 * (voxels_.size() + 1) > slots_.size()) {
+    if (voxels_.size() >= std::numeric_limits<uint32_t>::max() / 4)
+      throw Error("voxel object: more than 2^30 voxels; set VoxelOptions::max_voxels");
+    reindex(2 * slots_.size());
+  }
+  const size_t mask = slots_.size() - 1;
+  size_t s = hashOf(key) & mask;
+  for (; slots_[s] != 0; s = (s + 1) & mask)
+    if (keys_[slots_[s] - 1] == key) {
+      *added = false;
+      return slots_[s] - 1;
+    }
+  keys_.push_back(key);
+  voxels_.emplace_back();
+  slots_[s] = static_cast<uint32_t>(voxels_.size());
+  *added = true;
+  return voxels_.size() - 1;
+}
+
+void VoxelObject::reindex(size_t min_slots) {
+  size_t n = 16;
+  while (n < std::max(min_slots, 2 * (keys_.size() + 1))) n *= 2;
+  slots_.assign(n, 0);
+  const size_t mask = n - 1;
+  for (size_t i = 0; i < keys_.size(); ++i) {
+    size_t s = hashOf(keys_[i]) & mask;
+    while (slots_[s] != 0) s = (s + 1) & mask;
+    slots_[s] = static_cast<uint32_t>(i + 1);
+  }
+}
+
+template <class Keep>
+size_t VoxelObject::keepIf(Keep keep) {
+  size_t kept = 0;
+  for (size_t i = 0; i < voxels_.size(); ++i)
+    if (keep(voxels_[i])) keys_[kept] = keys_[i], voxels_[kept] = voxels_[i], ++kept;
+  const size_t removed = voxels_.size() - kept;
+  if (removed == 0) return 0;
+  keys_.resize(kept);
+  voxels_.resize(kept);
+  reindex(0);
+  return removed;
+}
+
 VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const DepthImage& depth,
                                    const BinaryMask& raw_mask) {
   checkInputs(K, pose, depth, raw_mask);
@@ -147,9 +212,9 @@ VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const 
       const Eigen::Vector3d x_w = R_wc * x_c + c_w;
       const auto key = keyOf(x_w);
       if (!key) continue;
-      auto [it, inserted] = voxels_.try_emplace(*key);
-      Voxel& v = it->second;
-      if (inserted) ++update.added;
+      bool added = false;
+      Voxel& v = voxels_[indexOrAdd(*key, &added)];
+      if (added) ++update.added;
       addToMean(v, (x_w - centreOf(*key)) / options_.voxel_size, 1);  // every point, not once per keyframe
       if (v.stamp == frames_) continue;
       v.stamp = frames_;
@@ -159,9 +224,10 @@ VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const 
   }
 
   // Misses: voxels not hit this keyframe that the camera should have seen as the object.
-  for (auto& [key, v] : voxels_) {
+  for (size_t i = 0; i < voxels_.size(); ++i) {
+    Voxel& v = voxels_[i];
     if (v.stamp == frames_) continue;
-    const Eigen::Vector3d x_c = pose.transform(centreOf(key));
+    const Eigen::Vector3d x_c = pose.transform(centreOf(keys_[i]));
     if (x_c.z() < options_.min_depth) continue;
     const int u = static_cast<int>(std::lround(K.fx * x_c.x() / x_c.z() + K.cx));
     const int w = static_cast<int>(std::lround(K.fy * x_c.y() / x_c.z() + K.cy));
@@ -184,45 +250,37 @@ void VoxelObject::enforceBudget() {
   if (options_.max_voxels == 0 || voxels_.size() <= options_.max_voxels) return;
   std::vector<float> odds;
   odds.reserve(voxels_.size());
-  for (const auto& [key, v] : voxels_) odds.push_back(v.log_odds);
+  for (const Voxel& v : voxels_) odds.push_back(v.log_odds);
   const size_t drop = voxels_.size() - options_.max_voxels;
   std::nth_element(odds.begin(), odds.begin() + static_cast<long>(drop), odds.end());
   const float cut = odds[drop];
-  // Everything below the cut goes (at most `drop` voxels), then voxels at the cut until done.
-  size_t dropped = 0;
-  for (const bool at_cut : {false, true}) {
-    for (auto it = voxels_.begin(); it != voxels_.end() && dropped < drop;) {
-      const float l = it->second.log_odds;
-      if (at_cut ? l == cut : l < cut) {
-        it = voxels_.erase(it);
-        ++dropped;
-      } else {
-        ++it;
-      }
+  // Everything below the cut goes (at most `drop` voxels), then the first voxels at the cut
+  // until `drop` are gone.
+  size_t at_cut =
+      drop - static_cast<size_t>(std::count_if(odds.begin(), odds.end(), [cut](float l) { return l < cut; }));
+  keepIf([&](const Voxel& v) {
+    if (v.log_odds < cut) return false;
+    if (v.log_odds == cut && at_cut > 0) {
+      --at_cut;
+      return false;
     }
-  }
+    return true;
+  });
 }
 
 size_t VoxelObject::prune(double probability) {
   if (!(probability > 0.0 && probability < 1.0)) return 0;
   const float cut = static_cast<float>(logit(probability));
-  size_t removed = 0;
-  for (auto it = voxels_.begin(); it != voxels_.end();) {
-    if (it->second.log_odds < cut) {
-      it = voxels_.erase(it);
-      ++removed;
-    } else {
-      ++it;
-    }
-  }
-  return removed;
+  return keepIf([cut](const Voxel& v) { return v.log_odds >= cut; });
 }
 
 void VoxelObject::absorb(const VoxelObject& other) {
   const float l_min = static_cast<float>(logit(options_.clamp_min));
   const float l_max = static_cast<float>(logit(options_.clamp_max));
-  for (const auto& [key, theirs] : other.voxels_) {
-    Voxel& v = voxels_[key];
+  for (size_t i = 0; i < other.voxels_.size(); ++i) {
+    const Voxel& theirs = other.voxels_[i];
+    bool added = false;
+    Voxel& v = voxels_[indexOrAdd(other.keys_[i], &added)];
     v.log_odds = std::clamp(v.log_odds + theirs.log_odds, l_min, l_max);
     addToMean(v, Eigen::Vector3d(theirs.mean[0], theirs.mean[1], theirs.mean[2]) / kMeanUnits, theirs.points);
     v.stamp = frames_;  // counts as touched by this object's latest keyframe, not by a future one
@@ -232,7 +290,7 @@ void VoxelObject::absorb(const VoxelObject& other) {
 
 size_t VoxelObject::occupiedCount() const {
   size_t n = 0;
-  for (const auto& [key, v] : voxels_) n += occupied(v);
+  for (const Voxel& v : voxels_) n += occupied(v);
   return n;
 }
 
@@ -251,8 +309,8 @@ std::vector<Eigen::Vector3d> VoxelObject::pointsAtOrAbove(std::optional<double> 
   const float cut = logOddsCut(min_probability);
   std::vector<Eigen::Vector3d> out;
   out.reserve(voxels_.size());
-  for (const auto& [key, v] : voxels_)
-    if (v.log_odds >= cut) out.push_back(point_of(key, v));
+  for (size_t i = 0; i < voxels_.size(); ++i)
+    if (voxels_[i].log_odds >= cut) out.push_back(point_of(keys_[i], voxels_[i]));
   return out;
 }
 
@@ -266,8 +324,8 @@ std::vector<Eigen::Vector3d> VoxelObject::occupiedPointMeans(std::optional<doubl
 
 Eigen::AlignedBox3d VoxelObject::bounds() const {
   Eigen::AlignedBox3d box;
-  for (const auto& [key, v] : voxels_)
-    if (occupied(v)) box.extend(centreOf(key));
+  for (size_t i = 0; i < voxels_.size(); ++i)
+    if (occupied(voxels_[i])) box.extend(centreOf(keys_[i]));
   return box;
 }
 
@@ -275,9 +333,9 @@ std::optional<Box> VoxelObject::projectedBox(const Intrinsics& K, const Pose& po
   if (!K.isValid() || !pose.isValid()) return std::nullopt;
   double x1 = 1e300, y1 = 1e300, x2 = -1e300, y2 = -1e300;
   int n = 0;
-  for (const auto& [key, v] : voxels_) {
-    if (!occupied(v)) continue;
-    const Eigen::Vector3d x_c = pose.transform(centreOf(key));
+  for (size_t i = 0; i < voxels_.size(); ++i) {
+    if (!occupied(voxels_[i])) continue;
+    const Eigen::Vector3d x_c = pose.transform(centreOf(keys_[i]));
     if (x_c.z() < 1e-3) continue;
     const double u = K.fx * x_c.x() / x_c.z() + K.cx, w = K.fy * x_c.y() / x_c.z() + K.cy;
     if (u < -0.5 || w < -0.5 || u > K.width - 0.5 || w > K.height - 0.5) continue;
@@ -303,13 +361,13 @@ long VoxelObject::countNear(const VoxelObject& other, double radius) const {
     return Eigen::Vector3i(floorDiv(g(0)), floorDiv(g(1)), floorDiv(g(2)));
   };
   std::unordered_map<uint64_t, std::vector<Eigen::Vector3i>> cells;
-  for (const auto& [key, v] : other.voxels_)
-    if (other.occupied(v)) {
-      const Eigen::Vector3i g = unpack(key), c = cellOf(g);
+  for (size_t i = 0; i < other.voxels_.size(); ++i)
+    if (other.occupied(other.voxels_[i])) {
+      const Eigen::Vector3i g = unpack(other.keys_[i]), c = cellOf(g);
       cells[pack(c(0), c(1), c(2))].push_back(g);
     }
   const auto hasNeighbour = [&](uint64_t key) {
-    if (const auto same = other.voxels_.find(key); same != other.voxels_.end() && other.occupied(same->second))
+    if (const long same = other.indexOf(key); same >= 0 && other.occupied(other.voxels_[static_cast<size_t>(same)]))
       return true;
     const Eigen::Vector3i g = unpack(key), c = cellOf(g);
     for (int dx = -1; dx <= 1; ++dx)
@@ -323,22 +381,21 @@ long VoxelObject::countNear(const VoxelObject& other, double radius) const {
     return false;
   };
   long n = 0;
-  for (const auto& [key, v] : voxels_)
-    if (occupied(v) && reach_box.contains(centreOf(key)) && hasNeighbour(key)) ++n;
+  for (size_t i = 0; i < voxels_.size(); ++i)
+    if (occupied(voxels_[i]) && reach_box.contains(centreOf(keys_[i])) && hasNeighbour(keys_[i])) ++n;
   return n;
 }
 
 double VoxelObject::probabilityAt(const Eigen::Vector3d& x_w) const {
   const auto key = keyOf(x_w);
   if (!key) return 0.5;
-  const auto it = voxels_.find(*key);
-  return it == voxels_.end() ? 0.5 : 1.0 / (1.0 + std::exp(-static_cast<double>(it->second.log_odds)));
+  const long i = indexOf(*key);
+  return i < 0 ? 0.5 : 1.0 / (1.0 + std::exp(-static_cast<double>(voxels_[static_cast<size_t>(i)].log_odds)));
 }
 
 size_t VoxelObject::memoryBytes() const {
-  // One node per voxel (key, value, next pointer, cached hash) plus the bucket array.
-  const size_t node = sizeof(uint64_t) + sizeof(Voxel) + 2 * sizeof(void*);
-  return voxels_.size() * node + voxels_.bucket_count() * sizeof(void*);
+  return keys_.capacity() * sizeof(uint64_t) + voxels_.capacity() * sizeof(Voxel) +
+         slots_.capacity() * sizeof(uint32_t);
 }
 
 BinaryMask maskFromBox(const Box& box, int image_width, int image_height) {

@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include "ellreloc/core/statistics.hpp"
 #include "ellreloc/error.hpp"
@@ -164,7 +166,8 @@ TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {
 TEST(VoxelObject, DepthGateDropsMaskPixelsOnTheBackground) {
   DepthImage depth = flatDepth(2.005f);
   for (int y = 0; y < kVoxelCamera.height; ++y)
-    for (int x = 0; x < 310; ++x) depth.metres[static_cast<size_t>(y) * kVoxelCamera.width + x] = 4.0f;  // a wall behind
+    for (int x = 0; x < 310; ++x)
+      depth.metres[static_cast<size_t>(y) * kVoxelCamera.width + x] = 4.0f;  // a wall behind
   VoxelObject v;
   v.integrate(kVoxelCamera, Pose(), depth, rectMask(300, 220, 360, 260));  // a sixth of the mask bleeds onto the wall
   for (const Eigen::Vector3d& c : v.occupiedCentres()) EXPECT_LT(c.z(), 2.1);
@@ -215,14 +218,43 @@ TEST(VoxelObject, PruneAndMemoryBudget) {
   for (const Eigen::Vector3d& c : w.occupiedCentres()) EXPECT_GT(c.x(), -0.01);
 }
 
+// The voxels are found by position through an index of their own: after it grows, after
+// pruning and after the memory budget cut it, every voxel is found where it is (a voxel the
+// index lost reads as unknown, 0.5) and none is held twice (a lost one would be made again).
+TEST(VoxelObject, EveryVoxelIsFoundAfterGrowthPruningAndTheBudget) {
+  VoxelOptions budget;
+  budget.max_voxels = 5000;
+  VoxelObject v(budget);
+  size_t pruned = 0;
+  for (int k = 0; k < 12; ++k) {
+    // Each keyframe a plane further and to the right: the last one's voxels are seen outside
+    // the mask (a miss), and every few keyframes the pruning takes them.
+    const DepthImage depth = flatDepth(1.5f + 0.013f * static_cast<float>(k));
+    const BinaryMask mask = rectMask(30 * k, 100, 30 * k + 150, 300);
+    v.integrate(kVoxelCamera, Pose(), depth, mask);
+    if (k % 4 == 3) pruned += v.prune(0.8);
+    v.integrate(kVoxelCamera, Pose(), depth, mask);
+  }
+  EXPECT_GT(pruned, 0u);
+  EXPECT_EQ(v.size(), 5000u);
+  const std::vector<Eigen::Vector3d> strong = v.occupiedCentres(0.75);
+  ASSERT_GT(strong.size(), 1000u);
+  for (const Eigen::Vector3d& c : strong) ASSERT_GE(v.probabilityAt(c), 0.75) << c.transpose();
+  std::set<std::array<long, 3>> cells;
+  for (const Eigen::Vector3d& c : v.occupiedCentres(1e-6))
+    cells.insert({std::lround(c.x() / 0.01 - 0.5), std::lround(c.y() / 0.01 - 0.5), std::lround(c.z() / 0.01 - 0.5)});
+  EXPECT_EQ(cells.size(), v.size());
+}
+
 TEST(VoxelObject, BadInputIsAnErrorNotACrash) {
   VoxelObject v;
   const BinaryMask mask = rectMask(300, 220, 340, 260);
   BinaryMask wrong(240, 320);
   EXPECT_THROW(v.integrate(kVoxelCamera, Pose(), flatDepth(2.005f), wrong), Error);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(v.integrate(kVoxelCamera, Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0)), flatDepth(2.005f), mask),
-               Error);
+  EXPECT_THROW(
+      v.integrate(kVoxelCamera, Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0)), flatDepth(2.005f), mask),
+      Error);
   DepthImage small = flatDepth(2.005f);
   small.width = 320;
   EXPECT_THROW(v.integrate(kVoxelCamera, Pose(), small, mask), Error);

@@ -13,7 +13,6 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <optional>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -50,7 +49,7 @@ struct VoxelOptions {
   bool mask_majority_filter = true;
   int pixel_stride = 1;  ///< use every n-th mask pixel in x and y (speed vs density)
   /// Memory bound: past this many voxels the least probable ones are dropped (about 40 bytes
-  /// per voxel with the hash table, so 200,000 voxels is about 8 MB per object).
+  /// per voxel with its key and index, so 200,000 voxels is about 8 MB per object).
   size_t max_voxels = 200000;
 };
 
@@ -101,7 +100,7 @@ class VoxelObject {
 
   /// The probability of the voxel containing a world point (0.5 when unknown).
   double probabilityAt(const Eigen::Vector3d& x_w) const;
-  /// Approximate heap memory in bytes (voxels and hash table).
+  /// Heap memory in bytes (voxels, keys and index, as allocated).
   size_t memoryBytes() const;
 
   const VoxelOptions& options() const { return options_; }
@@ -136,18 +135,25 @@ class VoxelObject {
   /// The [near, far] depths of the mask's hits (the depth gate).
   std::pair<double, double> depthGate(const DepthImage& depth, const BinaryMask& mask, int stride) const;
 
-  struct KeyHash {
-    size_t operator()(uint64_t k) const {  // splitmix64 finaliser: packed keys are far from random
-      k ^= k >> 30;
-      k *= 0xbf58476d1ce4e5b9ULL;
-      k ^= k >> 27;
-      k *= 0x94d049bb133111ebULL;
-      return static_cast<size_t>(k ^ (k >> 31));
-    }
-  };
+  /// The index of the voxel with `key`, or -1 when there is none.
+  long indexOf(uint64_t key) const;
+  /// The index of the voxel with `key`, created (probability 0.5, no points) when there is none.
+  size_t indexOrAdd(uint64_t key, bool* added);
+  /// Keeps the voxels for which keep(voxel) is true, in their order, and indexes them again.
+  template <class Keep>
+  size_t keepIf(Keep keep);
+  /// Rebuilds `slots_` for the voxels held, at least `min_slots` long and at most half full.
+  void reindex(size_t min_slots);
+
   VoxelOptions options_;
   float occupied_log_odds_;  // of options_.occupied_probability: occupied() runs once per voxel
-  std::unordered_map<uint64_t, Voxel, KeyHash> voxels_;
+  // The voxels in the order they were created (keys_[i] is voxels_[i]'s key), so that the passes
+  // over all of them (several per object and keyframe) read memory in sequence, found by key
+  // through `slots_`: an open-addressing table (linear probing, a power of two long, at most half
+  // full) of index + 1 into them, 0 for an empty slot.
+  std::vector<uint64_t> keys_;
+  std::vector<Voxel> voxels_;
+  std::vector<uint32_t> slots_;
   uint32_t frames_ = 0;
 };
 
