@@ -85,24 +85,24 @@ std::pair<double, double> VoxelObject::depthGate(const DepthImage& depth, const 
   return {std::max(range.first, centre - half), std::min(range.second, centre + half)};
 }
 
-uint64_t VoxelObject::pack(int x, int y, int z) {
+inline uint64_t VoxelObject::pack(int x, int y, int z) {
   return (static_cast<uint64_t>(x + kKeyOffset) << (2 * kKeyBits)) |
          (static_cast<uint64_t>(y + kKeyOffset) << kKeyBits) | static_cast<uint64_t>(z + kKeyOffset);
 }
 
-Eigen::Vector3i VoxelObject::unpack(uint64_t key) {
+inline Eigen::Vector3i VoxelObject::unpack(uint64_t key) {
   return Eigen::Vector3i(static_cast<int>((key >> (2 * kKeyBits)) & kKeyMask) - kKeyOffset,
                          static_cast<int>((key >> kKeyBits) & kKeyMask) - kKeyOffset,
                          static_cast<int>(key & kKeyMask) - kKeyOffset);
 }
 
-std::optional<uint64_t> VoxelObject::keyOf(const Eigen::Vector3d& x_w) const {
+inline std::optional<uint64_t> VoxelObject::keyOf(const Eigen::Vector3d& x_w) const {
   const Eigen::Vector3d g = (x_w / options_.voxel_size).array().floor();
   if (!g.allFinite() || g.cwiseAbs().maxCoeff() >= kKeyOffset - 1) return std::nullopt;
   return pack(static_cast<int>(g(0)), static_cast<int>(g(1)), static_cast<int>(g(2)));
 }
 
-Eigen::Vector3d VoxelObject::centreOf(uint64_t key) const {
+inline Eigen::Vector3d VoxelObject::centreOf(uint64_t key) const {
   return (unpack(key).cast<double>().array() + 0.5).matrix() * options_.voxel_size;
 }
 
@@ -121,7 +121,7 @@ void VoxelObject::addToMean(Voxel& v, const Eigen::Vector3d& offset, long count)
 VoxelObject::VoxelObject(const VoxelOptions& options)
     : options_(options), occupied_log_odds_(static_cast<float>(logit(options.occupied_probability))) {}
 
-bool VoxelObject::occupied(const Voxel& v) const { return v.log_odds >= occupied_log_odds_; }
+inline bool VoxelObject::occupied(const Voxel& v) const { return v.log_odds >= occupied_log_odds_; }
 
 long VoxelObject::indexOf(uint64_t key) const {
   if (slots_.empty()) return -1;
