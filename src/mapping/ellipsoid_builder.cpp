@@ -2,6 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
+#include <functional>
 #include <limits>
 
 #include "ellreloc/core/statistics.hpp"
@@ -10,28 +12,18 @@ namespace ellreloc {
 
 namespace {
 
-/// interpolatedQuantile(values, low) and (values, high) from one copy of `values` in
-/// `scratch` (reordered): the yaw search below takes thousands of them per object.
-std::pair<double, double> quantilePair(const std::vector<double>& values, double low, double high,
-                                       std::vector<double>* scratch) {
-  if (values.empty()) return {0.0, 0.0};
-  std::vector<double>& v = *scratch;
-  v.assign(values.begin(), values.end());
-  const double last = static_cast<double>(v.size() - 1);
-  // The q-quantile interpolates between the k-th and (k+1)-th smallest values, k = floor(q (n - 1)).
-  const auto at = [&](double q, size_t from) {
-    const double pos = std::clamp(q, 0.0, 1.0) * last;
-    const size_t k = static_cast<size_t>(pos);
-    std::nth_element(v.begin() + static_cast<long>(from), v.begin() + static_cast<long>(k), v.end());
-    if (k + 1 >= v.size()) return std::make_pair(v[k], k);
-    const double next = *std::min_element(v.begin() + static_cast<long>(k) + 1, v.end());
-    return std::make_pair(v[k] + (pos - static_cast<double>(k)) * (next - v[k]), k);
-  };
-  const auto [q_low, k_low] = at(low, 0);
-  // Everything after the low quantile's k-th value is at least it: a higher quantile's k-th
-  // value is among them.
-  const bool higher = std::clamp(high, 0.0, 1.0) >= std::clamp(low, 0.0, 1.0);
-  return {q_low, at(high, higher ? k_low : 0).first};
+/// The `m` smallest of `values` by `before` (the m largest with std::greater), in order, m <= M.
+template <size_t M, class Before>
+std::array<double, M> fewFirst(const std::vector<double>& values, size_t m, Before before) {
+  std::array<double, M> kept{};
+  size_t count = 0;
+  for (const double x : values) {
+    if (count == m && !before(x, kept[m - 1])) continue;
+    size_t at = count < m ? count++ : m - 1;  // the last kept value makes room
+    for (; at > 0 && before(x, kept[at - 1]); --at) kept[at] = kept[at - 1];
+    kept[at] = x;
+  }
+  return kept;
 }
 
 /// The percentile rectangle of ground-plane points along `main` and across it (lo, hi in
@@ -44,8 +36,8 @@ void percentileRectangle(const std::vector<Eigen::Vector2d>& ground, const Eigen
   across->resize(ground.size());
   for (size_t i = 0; i < ground.size(); ++i) (*along)[i] = main.dot(ground[i]), (*across)[i] = side.dot(ground[i]);
   thread_local std::vector<double> scratch;
-  const auto [along_lo, along_hi] = quantilePair(*along, low, high, &scratch);
-  const auto [across_lo, across_hi] = quantilePair(*across, low, high, &scratch);
+  const auto [along_lo, along_hi] = detail::quantilePair(*along, low, high, &scratch);
+  const auto [across_lo, across_hi] = detail::quantilePair(*across, low, high, &scratch);
   *lo = Eigen::Vector2d(along_lo, across_lo);
   *hi = Eigen::Vector2d(along_hi, across_hi);
 }
@@ -94,6 +86,42 @@ Eigen::Vector2d smallestPercentileRectangleNear(const std::vector<Eigen::Vector2
 }  // namespace
 
 namespace detail {
+
+// The yaw search takes thousands of quantile pairs per object, of the 1st and 99th percentiles
+// of at most 512 values: near the ends one pass keeps the few smallest and largest values;
+// elsewhere a copy in `scratch` is reordered.
+std::pair<double, double> quantilePair(const std::vector<double>& values, double low, double high,
+                                       std::vector<double>* scratch) {
+  if (values.empty()) return {0.0, 0.0};
+  const size_t n = values.size();
+  // The q-quantile interpolates between the k-th and (k+1)-th smallest values, k = floor(q (n - 1)).
+  const double pos_low = std::clamp(low, 0.0, 1.0) * static_cast<double>(n - 1);
+  const double pos_high = std::clamp(high, 0.0, 1.0) * static_cast<double>(n - 1);
+  const size_t k_low = static_cast<size_t>(pos_low), k_high = static_cast<size_t>(pos_high);
+  const auto between = [](double pos, size_t k, double a, double b) {
+    return a + (pos - static_cast<double>(k)) * (b - a);
+  };
+  constexpr size_t kFew = 16;
+  if (n > 2 * kFew && k_low + 2 <= kFew && n - k_high <= kFew && k_low <= k_high) {
+    const auto smallest = fewFirst<kFew>(values, k_low + 2, std::less<double>());
+    const size_t from_top = n - 1 - k_high;  // the k_high-th smallest is the from_top-th largest
+    const auto largest = fewFirst<kFew>(values, from_top + 1, std::greater<double>());
+    const double high_next = from_top > 0 ? largest[from_top - 1] : largest[from_top];
+    return {between(pos_low, k_low, smallest[k_low], smallest[k_low + 1]),
+            between(pos_high, k_high, largest[from_top], high_next)};
+  }
+  std::vector<double>& v = *scratch;
+  v.assign(values.begin(), values.end());
+  const auto at = [&](double pos, size_t k, size_t from) {
+    std::nth_element(v.begin() + static_cast<long>(from), v.begin() + static_cast<long>(k), v.end());
+    if (k + 1 >= n) return v[k];
+    return between(pos, k, v[k], *std::min_element(v.begin() + static_cast<long>(k) + 1, v.end()));
+  };
+  const double q_low = at(pos_low, k_low, 0);
+  // Everything after the low quantile's k-th value is at least it: a higher quantile's k-th
+  // value is among them.
+  return {q_low, at(pos_high, k_high, k_high >= k_low ? k_low : 0)};
+}
 
 /// The direction of the longer side of the smallest-area rectangle enclosing 2D points: the
 /// rectangle has a side on an edge of the convex hull, so each hull edge is tried.

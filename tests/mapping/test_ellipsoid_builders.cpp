@@ -5,6 +5,7 @@
 #include <random>
 
 #include "ellreloc/core/projection.hpp"
+#include "ellreloc/core/statistics.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
 #include "ellreloc/mapping/category_sizes.hpp"
 #include "ellreloc/mapping/ellipsoid_builder.hpp"
@@ -364,6 +365,29 @@ TEST(EllipsoidBuilder, StrayPointsDoNotTiltTheYaw) {
   std::sort(built_errors.begin(), built_errors.end());
   std::sort(hull_errors.begin(), hull_errors.end());
   EXPECT_LT(built_errors[10], 0.5 * hull_errors[10]) << built_errors[10] << " " << hull_errors[10];
+}
+
+// The yaw search's quantile pairs are interpolatedQuantile's to the bit: near the ends from the
+// few smallest and largest values, elsewhere by reordering; with ties, at every size around the
+// switch between the two and in either order of the two quantiles.
+TEST(EllipsoidBuilder, QuantilePairsAreInterpolatedQuantiles) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> coarse(0, 40);  // ties
+  std::normal_distribution<double> fine(0.0, 1.0);
+  std::vector<double> scratch;
+  const std::vector<std::pair<double, double>> quantiles = {{0.01, 0.99}, {0.02, 0.98}, {0.0, 1.0}, {0.1, 0.9},
+                                                            {0.5, 0.5},   {0.99, 0.01}, {-1.0, 2.0}};
+  for (const size_t n : {1, 2, 3, 31, 32, 33, 40, 100, 511, 512, 1000, 1600, 5000}) {
+    for (const bool ties : {false, true}) {
+      std::vector<double> values(n);
+      for (double& v : values) v = ties ? coarse(rng) * 0.25 : fine(rng);
+      for (const auto& [low, high] : quantiles) {
+        const auto [q_low, q_high] = detail::quantilePair(values, low, high, &scratch);
+        EXPECT_EQ(q_low, interpolatedQuantile(values, low)) << n << " " << low;
+        EXPECT_EQ(q_high, interpolatedQuantile(values, high)) << n << " " << high;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "ellreloc/core/ellipsoid.hpp"
@@ -71,6 +72,9 @@ namespace detail {
 /// The direction of the longer side of the smallest-area rectangle enclosing 2D points: the
 /// rectangle has a side on an edge of the convex hull, so each hull edge is tried.
 std::optional<Eigen::Vector2d> minAreaRectangleAxis(std::vector<Eigen::Vector2d> p);
+/// interpolatedQuantile(values, low) and (values, high), to the bit, with `scratch` for room.
+std::pair<double, double> quantilePair(const std::vector<double>& values, double low, double high,
+                                       std::vector<double>* scratch);
 }  // namespace detail
 
 /// A right-handed world basis (e1, e2, up) with e1, e2 spanning the ground plane.
