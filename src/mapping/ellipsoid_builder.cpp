@@ -126,6 +126,26 @@ std::pair<double, double> quantilePair(const std::vector<double>& values, double
 /// The direction of the longer side of the smallest-area rectangle enclosing 2D points: the
 /// rectangle has a side on an edge of the convex hull, so each hull edge is tried.
 std::optional<Eigen::Vector2d> minAreaRectangleAxis(std::vector<Eigen::Vector2d> p) {
+  if (p.size() < 3) return std::nullopt;
+  // Points well inside the quadrilateral of the leftmost, lowest, rightmost and highest points
+  // are inside the hull: they are dropped before the sort (Akl and Toussaint), which leaves a
+  // few percent of a footprint's thousands of points.
+  const auto by = [&](int axis, bool least) {
+    return *std::min_element(p.begin(), p.end(), [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+      return least ? a(axis) < b(axis) : a(axis) > b(axis);
+    });
+  };
+  const std::array<Eigen::Vector2d, 4> quad = {by(0, true), by(1, true), by(0, false), by(1, false)};
+  const double margin = 1e-9 * (quad[2].x() - quad[0].x() + quad[3].y() - quad[1].y()) *
+                        (quad[2].x() - quad[0].x() + quad[3].y() - quad[1].y());
+  const auto wellInside = [&](const Eigen::Vector2d& q) {
+    for (int i = 0; i < 4; ++i) {
+      const Eigen::Vector2d e = quad[(i + 1) % 4] - quad[i], d = q - quad[i];
+      if (!(e.x() * d.y() - e.y() * d.x() > margin)) return false;  // counter-clockwise: inside is left
+    }
+    return true;
+  };
+  p.erase(std::remove_if(p.begin(), p.end(), wellInside), p.end());
   std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
   });

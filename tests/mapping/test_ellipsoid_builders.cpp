@@ -367,6 +367,36 @@ TEST(EllipsoidBuilder, StrayPointsDoNotTiltTheYaw) {
   EXPECT_LT(built_errors[10], 0.5 * hull_errors[10]) << built_errors[10] << " " << hull_errors[10];
 }
 
+// The smallest rectangle around points rests on an edge of their hull, so trying the direction
+// of every pair of points finds its area too; points inside the hull (most of a footprint,
+// dropped before the hull is built) change nothing.
+TEST(EllipsoidBuilder, MinAreaRectangleIsTheSmallestOverEveryPairsDirection) {
+  std::mt19937 rng(8);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const auto areaAlong = [](const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector2d& axis) {
+    const Eigen::Vector2d u = axis.normalized(), v(-u.y(), u.x());
+    double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
+    for (const Eigen::Vector2d& q : pts)
+      u_lo = std::min(u_lo, u.dot(q)), u_hi = std::max(u_hi, u.dot(q)), v_lo = std::min(v_lo, v.dot(q)),
+      v_hi = std::max(v_hi, v.dot(q));
+    return (u_hi - u_lo) * (v_hi - v_lo);
+  };
+  for (int trial = 0; trial < 10; ++trial) {
+    std::vector<Eigen::Vector2d> pts;
+    const double c = std::cos(0.3 * trial), s = std::sin(0.3 * trial);
+    for (int i = 0; i < 150; ++i) {
+      const Eigen::Vector2d local(0.4 * g(rng), 0.1 * g(rng));  // elongated, turned
+      pts.emplace_back(c * local.x() - s * local.y() + 2.0, s * local.x() + c * local.y() - 1.0);
+    }
+    double best = 1e300;
+    for (size_t i = 0; i < pts.size(); ++i)
+      for (size_t j = i + 1; j < pts.size(); ++j) best = std::min(best, areaAlong(pts, pts[j] - pts[i]));
+    const auto axis = detail::minAreaRectangleAxis(pts);
+    ASSERT_TRUE(axis);
+    EXPECT_NEAR(areaAlong(pts, *axis), best, 1e-12 * best) << trial;
+  }
+}
+
 // The yaw search's quantile pairs are interpolatedQuantile's to the bit: near the ends from the
 // few smallest and largest values, elsewhere by reordering; with ties, at every size around the
 // switch between the two and in either order of the two quantiles.
