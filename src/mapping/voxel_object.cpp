@@ -123,14 +123,17 @@ VoxelObject::VoxelObject(const VoxelOptions& options)
 
 inline bool VoxelObject::occupied(const Voxel& v) const { return v.log_odds >= occupied_log_odds_; }
 
+size_t VoxelObject::slotOf(uint64_t key) const {
+  const size_t mask = slots_.size() - 1;
+  size_t s = hashOf(key) & mask;
+  while (slots_[s] != 0 && keys_[slots_[s] - 1] != key) s = (s + 1) & mask;
+  return s;
+}
+
 long VoxelObject::indexOf(uint64_t key) const {
   if (slots_.empty()) return -1;
-  const size_t mask = slots_.size() - 1;
-  for (size_t s = hashOf(key) & mask;; s = (s + 1) & mask) {
-    const uint32_t slot = slots_[s];
-    if (slot == 0) return -1;
-    if (keys_[slot - 1] == key) return static_cast<long>(slot - 1);
-  }
+  const uint32_t slot = slots_[slotOf(key)];
+  return slot == 0 ? -1 : static_cast<long>(slot - 1);
 }
 
 size_t VoxelObject::indexOrAdd(uint64_t key, bool* added) {
@@ -139,17 +142,12 @@ size_t VoxelObject::indexOrAdd(uint64_t key, bool* added) {
       throw Error("voxel object: more than 2^30 voxels; set VoxelOptions::max_voxels");
     reindex(2 * slots_.size());
   }
-  const size_t mask = slots_.size() - 1;
-  size_t s = hashOf(key) & mask;
-  for (; slots_[s] != 0; s = (s + 1) & mask)
-    if (keys_[slots_[s] - 1] == key) {
-      *added = false;
-      return slots_[s] - 1;
-    }
+  const size_t s = slotOf(key);
+  *added = slots_[s] == 0;
+  if (!*added) return slots_[s] - 1;
   keys_.push_back(key);
   voxels_.emplace_back();
   slots_[s] = static_cast<uint32_t>(voxels_.size());
-  *added = true;
   return voxels_.size() - 1;
 }
 
@@ -157,12 +155,7 @@ void VoxelObject::reindex(size_t min_slots) {
   size_t n = 16;
   while (n < std::max(min_slots, 2 * (keys_.size() + 1))) n *= 2;
   slots_.assign(n, 0);
-  const size_t mask = n - 1;
-  for (size_t i = 0; i < keys_.size(); ++i) {
-    size_t s = hashOf(keys_[i]) & mask;
-    while (slots_[s] != 0) s = (s + 1) & mask;
-    slots_[s] = static_cast<uint32_t>(i + 1);
-  }
+  for (size_t i = 0; i < keys_.size(); ++i) slots_[slotOf(keys_[i])] = static_cast<uint32_t>(i + 1);
 }
 
 template <class Keep>

@@ -135,6 +135,8 @@ class VoxelObject {
   /// The [near, far] depths of the mask's hits (the depth gate).
   std::pair<double, double> depthGate(const DepthImage& depth, const BinaryMask& mask, int stride) const;
 
+  /// The slot of `slots_` that holds `key`, or the empty one where it would go (slots_ not empty).
+  size_t slotOf(uint64_t key) const;
   /// The index of the voxel with `key`, or -1 when there is none.
   long indexOf(uint64_t key) const;
   /// The index of the voxel with `key`, created (probability 0.5, no points) when there is none.
