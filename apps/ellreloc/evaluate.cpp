@@ -98,10 +98,11 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
   std::vector<size_t> truth_index;  // its ground-truth pose
   std::vector<double> frame_times;  // every frame's time, with a ground-truth pose or not
   if (!a.detections.empty()) {
+    const io::TimeIndex truth_by_time = io::timeIndex(gt);
     for (const DetectionFrame& f : io::readDetections(a.detections))
       if (const auto t = f.timestamp()) {
         frame_times.push_back(*t);
-        if (const auto g = io::findNearest(gt, *t))
+        if (const auto g = truth_by_time.nearest(*t))
           e.frames.push_back(f.timestampText()), times.push_back(*t), truth_index.push_back(*g);
       }
   } else {
@@ -125,8 +126,9 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
     // An estimate without poses is a run that relocalized nothing: 0% valid, not an error.
     const std::vector<io::StampedPose> est = io::readTumTrajectory(path, /*allow_empty=*/true);
     MethodEvaluation m{label, path, {}, {}, {}};
+    const io::TimeIndex by_time = io::timeIndex(est);
     for (size_t i = 0; i < e.frames.size(); ++i) {
-      const auto k = io::findNearest(est, times[i], 1e-4);
+      const auto k = by_time.nearest(times[i], 1e-4);
       m.errors.push_back(k ? std::optional(poseError(est[*k].pose, gt[truth_index[i]].pose)) : std::nullopt);
       m.centres.push_back(k ? std::optional(est[*k].pose.center()) : std::nullopt);
     }

@@ -27,10 +27,10 @@ namespace {
 /// undistorted (one that cannot be, far outside the image, is left out).
 std::vector<PosedDetections> posedFrames(const std::vector<DetectionFrame>& frames,
                                          const std::vector<io::StampedPose>& trajectory,
-                                         const std::optional<Lens>& lens) {
+                                         const io::TimeIndex& by_time, const std::optional<Lens>& lens) {
   std::vector<PosedDetections> out;
   for (const DetectionFrame& f : frames)
-    if (const Pose* pose = io::framePose(trajectory, f)) {
+    if (const Pose* pose = io::framePose(trajectory, by_time, f)) {
       out.push_back({*pose, {}});
       for (Detection d : f.detections) {
         if (lens) {
@@ -148,22 +148,23 @@ void map(const MapArgs& a, const Console& console) {
                                        : a.associations + ": no association");
   const fs::path detections_dir = fs::path(a.detections).parent_path();
   const io::AssociationIndex association_of(associations);
+  const io::TimeIndex by_time = io::timeIndex(trajectory);
 
   Mapper mapper(K, options);
   std::vector<PosedDetections> held_out;
-  if (!a.holdout.empty()) held_out = posedFrames(io::readDetections(a.holdout), trajectory, options.lens);
+  if (!a.holdout.empty()) held_out = posedFrames(io::readDetections(a.holdout), trajectory, by_time, options.lens);
   int used = 0, no_pose = 0, no_depth = 0;
   for (size_t i = 0; i < frames.size(); ++i) {
     const DetectionFrame& f = frames[i];
     if (a.holdout_every > 0 && i % static_cast<size_t>(a.holdout_every) == static_cast<size_t>(a.holdout_every) - 1) {
-      std::vector<PosedDetections> one = posedFrames({f}, trajectory, options.lens);
+      std::vector<PosedDetections> one = posedFrames({f}, trajectory, by_time, options.lens);
       held_out.insert(held_out.end(), one.begin(), one.end());
       continue;
     }
     // The frame's depth: the association naming the same colour image, else the nearest time.
     const io::Association* assoc = association_of.find((detections_dir / f.file_name).string(), f.timestamp());
     const std::optional<double> t = assoc ? std::optional<double>(assoc->rgb_time) : f.timestamp();
-    const std::optional<size_t> k = t ? io::findNearest(trajectory, *t) : std::nullopt;
+    const std::optional<size_t> k = t ? by_time.nearest(*t) : std::nullopt;
     if (!k) {
       ++no_pose;
       continue;

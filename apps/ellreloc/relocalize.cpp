@@ -359,8 +359,9 @@ std::vector<std::optional<Pose>> trackPoses(const RelocalizeArgs& a, const std::
   *without = 0;
   if (a.track.empty()) return poses;
   const std::vector<io::StampedPose> odometry = io::readTumTrajectory(a.track);
+  const io::TimeIndex by_time = io::timeIndex(odometry);
   for (size_t i = 0; i < timestamps.size(); ++i) {
-    if (const auto k = io::findNearest(odometry, timestamps[i]))
+    if (const auto k = by_time.nearest(timestamps[i]))
       poses[i] = odometry[*k].pose;
     else
       ++*without;
@@ -522,8 +523,9 @@ std::vector<std::optional<Pose>> referencePoses(const RelocalizeArgs& a, const s
   std::vector<std::optional<Pose>> references(timestamps.size());
   if (a.reference.empty()) return references;
   const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.reference, true);
+  const io::TimeIndex by_time = io::timeIndex(trajectory);
   for (size_t i = 0; i < timestamps.size(); ++i)
-    if (const auto k = io::findNearest(trajectory, timestamps[i])) references[i] = trajectory[*k].pose;
+    if (const auto k = by_time.nearest(timestamps[i])) references[i] = trajectory[*k].pose;
   return references;
 }
 

@@ -697,6 +697,12 @@ class Summary:
     valid_percent: float
 
 
+class TimeIndex:
+    """Times indexed once for many lookups of the nearest."""
+    def __init__(self, times: list[float]) -> None: ...
+    def nearest(self, timestamp: float, tolerance: float = ...) -> Optional[int]: """Position of the time nearest to `timestamp`, if within `tolerance` seconds, else None (of equally near, the last)."""
+
+
 class TrackRelocalizer:
     """Relocalizes each new frame of a track a host follows without the map (its odometry gives each frame's pose): every frame's poses, carried to the newest frame, ranked over the whole track (docs/pose.md, 'Over a track')."""
     def __init__(self, relocalizer: object, max_frames: int = ..., min_mean_evidence: float = ..., min_margin: float = ..., metric_odometry: bool = ...) -> None: """metric_odometry=False for a monocular host's odometry, whose scale is unknown: the track estimates it (TrackResult.scale)."""
@@ -760,7 +766,7 @@ def box_iou(a: Box, b: Box) -> float: """Intersection over union of two boxes (0
 
 def estimate_map_up(map: ObjectMap, min_t: float = ...) -> Optional[dict[str, Any]]: """Which way is up in a map from its objects alone: the direction of least spread of their centres, signed by the usual heights of their categories; a dict (up, t, objects) when the evidence is clear, else None."""
 
-def find_nearest(poses: Sequence[StampedPose | tuple[float | str, Pose]], timestamp: float, tolerance: float = ...) -> Optional[int]: """Index of the pose nearest in time, if within `tolerance` seconds, else None."""
+def find_nearest(poses: Sequence[StampedPose | tuple[float | str, Pose]], timestamp: float, tolerance: float = ...) -> Optional[int]: """Index of the pose nearest in time, if within `tolerance` seconds, else None (of equally near, the last). Reads every pose: for many lookups, time_index(poses)."""
 
 def fit_mask_ellipse(mask: MaskLike, method: MaskFitMethod = ...) -> Optional[Ellipse]: """An ellipse fitted to a mask; None when the fit fails (an empty mask). quadrilateral uses the mask's four-corner reduction, which describes regular masks only (test_regular_mask)."""
 
@@ -805,6 +811,8 @@ def refine_pose(camera: Intrinsics, initial: Pose, matches: Sequence[EllipseMatc
 def summarize(errors: list[Optional[PoseError]]) -> Summary: """Table-I row from one entry per query frame: its PoseError, or None when it got no pose."""
 
 def test_regular_mask(mask: MaskLike, options: Optional[RegularMaskOptions] = ...) -> RegularVerdict: """Is the mask roughly a convex quadrilateral (a 'regular' object of the paper)?"""
+
+def time_index(poses: Sequence[StampedPose | tuple[float | str, Pose]]) -> TimeIndex: """The poses' timestamps as a TimeIndex: index.nearest(t, tolerance) is find_nearest(poses, t, tolerance)."""
 
 def wasserstein(a: Ellipse, b: Ellipse) -> float: """2-Wasserstein distance (px) between the ellipses' Gaussians; inf for invalid ellipses."""
 

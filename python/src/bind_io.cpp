@@ -65,7 +65,15 @@ void bindTrajectory(py::module_& m) {
       "Writes StampedPose or (timestamp, Pose) items as a TUM trajectory, atomically; a str timestamp is "
       "written as given.");
   m.def("find_nearest", &io::findNearest, py::arg("poses"), py::arg("timestamp"), py::arg("tolerance") = 0.02,
-        "Index of the pose nearest in time, if within `tolerance` seconds, else None.");
+        "Index of the pose nearest in time, if within `tolerance` seconds, else None (of equally near, the last). "
+        "Reads every pose: for many lookups, time_index(poses).");
+  py::class_<io::TimeIndex>(m, "TimeIndex", "Times indexed once for many lookups of the nearest.")
+      .def(py::init<std::vector<double>>(), py::arg("times"))
+      .def("nearest", &io::TimeIndex::nearest, py::arg("timestamp"), py::arg("tolerance") = 0.02,
+           "Position of the time nearest to `timestamp`, if within `tolerance` seconds, else None (of equally "
+           "near, the last).");
+  m.def("time_index", &io::timeIndex, py::arg("poses"),
+        "The poses' timestamps as a TimeIndex: index.nearest(t, tolerance) is find_nearest(poses, t, tolerance).");
 }
 
 void bindFiles(py::module_& m) {

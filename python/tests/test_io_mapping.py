@@ -26,6 +26,9 @@ def test_camera_and_trajectory_round_trips(fr2, data_dir, tmp_path):
     E.write_trajectory(tmp_path / "c.txt", [(p.timestamp, p.pose) for p in truth[:3]])
     assert [p.timestamp for p in E.read_trajectory(tmp_path / "c.txt")] == [p.timestamp for p in truth[:3]]
     assert E.find_nearest(truth, truth[5].timestamp + 0.01) == 5 and E.find_nearest(truth, 0.0) is None
+    by_time = E.time_index(truth)
+    assert by_time.nearest(truth[5].timestamp + 0.01) == 5 and by_time.nearest(0.0) is None
+    assert E.TimeIndex([2.0, 1.0, 2.0]).nearest(1.5, tolerance=0.5) == 2  # equally near: the last
     with pytest.raises(ValueError, match="refusing to write two poses at timestamp"):
         E.write_trajectory(tmp_path / "d.txt", [("1.0", truth[0].pose), ("1.0", truth[1].pose)])
     assert not (tmp_path / "d.txt").exists()

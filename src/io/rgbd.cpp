@@ -1,10 +1,8 @@
 #include "ellreloc/io/rgbd.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <iterator>
 #include <sstream>
 #include <system_error>
 
@@ -17,6 +15,13 @@ namespace ellreloc::io {
 namespace {
 
 /// The path made absolute (as given when it cannot be: empty, or no current directory) and normalised.
+std::vector<double> rgbTimes(const std::vector<Association>& associations) {
+  std::vector<double> times;
+  times.reserve(associations.size());
+  for (const Association& a : associations) times.push_back(a.rgb_time);
+  return times;
+}
+
 std::string absoluteNormal(const std::string& path) {
   std::error_code error;
   const std::filesystem::path absolute = std::filesystem::absolute(path, error);
@@ -52,32 +57,19 @@ std::vector<Association> readAssociations(const std::string& path) {
 }
 
 AssociationIndex::AssociationIndex(std::vector<Association> associations, double tolerance)
-    : associations_(std::move(associations)), tolerance_(tolerance) {
+    : associations_(std::move(associations)), tolerance_(tolerance), by_time_(rgbTimes(associations_)) {
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
     throw Error("association index: the time tolerance must be finite and >= 0, got " + std::to_string(tolerance));
-  for (size_t k = 0; k < associations_.size(); ++k) {
-    by_image_[absoluteNormal(associations_[k].rgb_path)] = k;
-    by_time_.emplace_back(associations_[k].rgb_time, k);
-  }
-  std::sort(by_time_.begin(), by_time_.end());
+  for (size_t k = 0; k < associations_.size(); ++k) by_image_[absoluteNormal(associations_[k].rgb_path)] = k;
 }
 
 const Association* AssociationIndex::find(const std::string& rgb_path, std::optional<double> rgb_time) const {
   if (associations_.empty()) return nullptr;
   if (const auto named = by_image_.find(absoluteNormal(rgb_path)); named != by_image_.end())
     return &associations_[named->second];
-  if (!rgb_time || !std::isfinite(*rgb_time)) return nullptr;
-  // The nearest time is the first at or after it, or the one before.
-  const auto after = std::lower_bound(by_time_.begin(), by_time_.end(), std::make_pair(*rgb_time, size_t{0}));
-  const Association* nearest = nullptr;
-  double nearest_dt = tolerance_;
-  if (after != by_time_.begin()) {
-    const auto before = std::prev(after);
-    if (*rgb_time - before->first <= nearest_dt)
-      nearest = &associations_[before->second], nearest_dt = *rgb_time - before->first;
-  }
-  if (after != by_time_.end() && after->first - *rgb_time <= nearest_dt) nearest = &associations_[after->second];
-  return nearest;
+  if (!rgb_time) return nullptr;
+  const std::optional<size_t> nearest = by_time_.nearest(*rgb_time, tolerance_);
+  return nearest ? &associations_[*nearest] : nullptr;
 }
 
 DepthImage readDepthPng(const std::string& path, double units_per_metre) {

@@ -76,9 +76,23 @@ std::optional<size_t> findNearest(const std::vector<StampedPose>& poses, double 
   return best;
 }
 
+TimeIndex timeIndex(const std::vector<StampedPose>& poses) {
+  std::vector<double> times;
+  times.reserve(poses.size());
+  for (const StampedPose& p : poses) times.push_back(p.timestamp);
+  return TimeIndex(times);
+}
+
 const Pose* framePose(const std::vector<StampedPose>& poses, const DetectionFrame& frame, double tolerance) {
   const std::optional<double> t = frame.timestamp();
   const std::optional<size_t> k = t ? findNearest(poses, *t, tolerance) : std::nullopt;
+  return k ? &poses[*k].pose : nullptr;
+}
+
+const Pose* framePose(const std::vector<StampedPose>& poses, const TimeIndex& by_time, const DetectionFrame& frame,
+                      double tolerance) {
+  const std::optional<double> t = frame.timestamp();
+  const std::optional<size_t> k = t ? by_time.nearest(*t, tolerance) : std::nullopt;
   return k ? &poses[*k].pose : nullptr;
 }
 

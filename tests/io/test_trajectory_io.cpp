@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include "ellreloc/error.hpp"
@@ -58,6 +60,39 @@ TEST(TrajectoryIo, AFramesPoseIsTheOneNearestToItsFileNamesTimestamp) {
   EXPECT_EQ(io::framePose(poses, frame("rgb/101.4.png"), 0.6), &poses[1].pose);
   EXPECT_EQ(io::framePose(poses, frame("rgb/frame_0001.png")), nullptr);  // no timestamp in the name
   EXPECT_EQ(io::framePose({}, frame("rgb/101.png")), nullptr);
+}
+
+TEST(TrajectoryIo, TheTimeIndexFindsWhatAPassOverEveryPoseFinds) {
+  // Unsorted times on a grid of binary fractions (exact in floating point), so that many lookups
+  // are ties: equally near on both sides, or several poses at one time; one time that is not
+  // finite is never found.
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> tick(0, 40);
+  std::vector<io::StampedPose> poses(60);
+  for (io::StampedPose& p : poses) p.timestamp = 5.0 + 0.25 * tick(rng);
+  poses[13].timestamp = std::nan("");
+  const io::TimeIndex by_time = io::timeIndex(poses);
+  int found = 0, ties = 0;
+  for (double t = 4.0; t < 16.0; t += 0.0625) {
+    for (const double tolerance : {0.0, 0.125, 0.25, 3.0}) {
+      const std::optional<size_t> k = io::findNearest(poses, t, tolerance);
+      EXPECT_EQ(by_time.nearest(t, tolerance), k) << t << " within " << tolerance;
+      found += k.has_value();
+      if (k) ties += std::count_if(poses.begin(), poses.end(), [&](const io::StampedPose& p) {
+                       return std::abs(p.timestamp - t) == std::abs(poses[*k].timestamp - t);
+                     }) > 1;
+    }
+  }
+  EXPECT_GT(found, 300);  // the lookups above do find poses, and many among equals
+  EXPECT_GT(ties, 100);
+  EXPECT_EQ(by_time.nearest(std::nan(""), 1.0), std::nullopt);
+  EXPECT_EQ(by_time.nearest(5.1, std::nan("")), std::nullopt);
+  EXPECT_EQ(by_time.nearest(5.1, -1.0), std::nullopt);
+  EXPECT_EQ(io::TimeIndex({}).nearest(5.1, 1.0), std::nullopt);
+  // A frame's pose through the index is the one framePose finds by reading every pose.
+  const auto frame = [](const std::string& name) { return DetectionFrame{name, {}, {}}; };
+  for (const char* name : {"rgb/5.25.png", "rgb/5.26.png", "rgb/4.9.png", "rgb/none.png"})
+    EXPECT_EQ(io::framePose(poses, by_time, frame(name)), io::framePose(poses, frame(name))) << name;
 }
 
 TEST(TrajectoryIo, ReadsTheFr2Keyframes) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ellreloc/core/depth_image.hpp"
+#include "ellreloc/io/time_index.hpp"
 
 namespace ellreloc::io {
 
@@ -27,8 +28,8 @@ std::vector<Association> readAssociations(const std::string& path);
 
 /// Each colour image's association in a sequence: the line naming the same image (paths
 /// compared made absolute and normalised; of several, the last), else the line whose colour
-/// image is nearest in time within `tolerance` seconds. Indexed once, so that each of thousands
-/// of frames is found without reading every line.
+/// image is nearest in time within `tolerance` seconds (of equally near, the last). Indexed
+/// once, so that each of thousands of frames is found without reading every line.
 class AssociationIndex {
  public:
   /// Throws ellreloc::Error for a tolerance that is negative or not finite.
@@ -40,7 +41,7 @@ class AssociationIndex {
   std::vector<Association> associations_;
   double tolerance_;
   std::unordered_map<std::string, size_t> by_image_;
-  std::vector<std::pair<double, size_t>> by_time_;  // sorted
+  TimeIndex by_time_;
 };
 
 /// TUM's scale: 5000 depth units per metre.

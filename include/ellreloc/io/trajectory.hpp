@@ -9,6 +9,7 @@
 
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/detection.hpp"
+#include "ellreloc/io/time_index.hpp"
 
 namespace ellreloc::io {
 
@@ -30,11 +31,19 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path, bool allow_e
 /// timestamp and two poses at the same timestamp.
 void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses);
 
-/// Index of the pose whose timestamp is nearest to t, if within `tolerance` seconds.
+/// Index of the pose whose timestamp is nearest to t, if within `tolerance` seconds; of several
+/// equally near, the last. Reads every pose: to find many frames' poses, index them once
+/// (timeIndex).
 std::optional<size_t> findNearest(const std::vector<StampedPose>& poses, double t, double tolerance = 0.02);
+
+/// The poses' timestamps indexed for many lookups: nearest(t, tolerance) is findNearest's answer.
+TimeIndex timeIndex(const std::vector<StampedPose>& poses);
 
 /// The pose of a detection frame: the trajectory's pose nearest to the timestamp of the frame's
 /// file name, within `tolerance` seconds; nullptr when there is none (or no timestamp).
 const Pose* framePose(const std::vector<StampedPose>& poses, const DetectionFrame& frame, double tolerance = 0.02);
+/// The same with the poses' timeIndex, for many frames.
+const Pose* framePose(const std::vector<StampedPose>& poses, const TimeIndex& by_time, const DetectionFrame& frame,
+                      double tolerance = 0.02);
 
 }  // namespace ellreloc::io
