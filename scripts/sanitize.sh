@@ -18,7 +18,8 @@ jobs="$(nproc)"
 # Unity builds (CMake merges each target's sources eight at a time): the Eigen templates every
 # file instantiates are instantiated once per batch, which nearly halves the instrumented build
 # (ASan: 451 s against 833 s on 2 cores). So two source files of one target must not define the
-# same name at namespace scope, anonymous namespaces included; the release build stays per file.
+# same name at namespace scope, anonymous namespaces included; the release build batches the
+# tests, the command and the Python extension too, but compiles the library file by file.
 # No Python bindings: an instrumented extension needs the sanitizer runtime preloaded into python.
 common=(-G Ninja -DCMAKE_BUILD_TYPE= -DCMAKE_UNITY_BUILD=ON -DELLRELOC_BUILD_BENCHMARKS=OFF -DELLRELOC_PYTHON=OFF)
 export CC=clang-14 CXX=clang++-14

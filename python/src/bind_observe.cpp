@@ -27,7 +27,7 @@ ObserveOptions optionsFrom(const std::optional<ObserveOptions>& options, const p
   return o;
 }
 
-void bindOptions(py::module_& m) {
+void bindObserveOptions(py::module_& m) {
   py::enum_<ObservationPolicy>(m, "ObservationPolicy", "Which ellipse a detection gives.")
       .value("solid", ObservationPolicy::Solid,
              "regular mask -> mask fit, a solid one (options.solid_min_solidity) -> hull fit, otherwise the box")
@@ -178,7 +178,7 @@ void bindFunctions(py::module_& m) {
 }  // namespace
 
 void bindObserve(py::module_& m) {
-  bindOptions(m);
+  bindObserveOptions(m);
   bindResults(m);
   bindFunctions(m);
 }

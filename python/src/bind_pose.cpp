@@ -327,7 +327,7 @@ void bindPriors(py::module_& m) {
       .def("admits", &CameraEnvelope::admits, py::arg("pose"));
 }
 
-void bindOptions(py::module_& m) {
+void bindRelocalizerOptions(py::module_& m) {
   bindOptionGroups(m);
   bindPriors(m);
   py::class_<RelocalizerOptions>(m, "RelocalizerOptions",
@@ -611,7 +611,7 @@ void bindRefiner(py::module_& m) {
 }  // namespace
 
 void bindPose(py::module_& m) {
-  bindOptions(m);
+  bindRelocalizerOptions(m);
   bindResult(m);
   bindRelocalizer(m);
   bindTrack(m);
