@@ -14,7 +14,7 @@ namespace ellreloc::io {
 
 namespace {
 
-/// The path made absolute (as given when it cannot be: empty, or no current directory) and normalised.
+/// Each line's colour image time, in line order.
 std::vector<double> rgbTimes(const std::vector<Association>& associations) {
   std::vector<double> times;
   times.reserve(associations.size());
@@ -22,6 +22,7 @@ std::vector<double> rgbTimes(const std::vector<Association>& associations) {
   return times;
 }
 
+/// The path made absolute (as given when it cannot be: empty, or no current directory) and normalised.
 std::string absoluteNormal(const std::string& path) {
   std::error_code error;
   const std::filesystem::path absolute = std::filesystem::absolute(path, error);
