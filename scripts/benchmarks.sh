@@ -34,6 +34,7 @@ table() {  # NAME COMMAND...: an accuracy binary that prints a Markdown table
 
 gbench core bench_core
 gbench p3p bench_p3p
+gbench frame_poses bench_io
 gbench refiner bench_pose 'Refine'
 gbench relocalize_room bench_pose 'Relocalize47|WorstCase'
 gbench huge_frames bench_pose 'HugeFrame'
