@@ -37,9 +37,10 @@ else:
 
 # Every frame against the ground truth: the paper's Table I row (30 cm / 30 degree rule).
 truth = ellreloc.read_trajectory(data / "keyframes.groundtruth.txt")
+truth_by_time = ellreloc.time_index(truth)  # each frame's true pose: the nearest in time, within 20 ms
 errors = []
 for frame, r in zip(frames, relocalizer.relocalize_frames(frames)):
-    k = ellreloc.find_nearest(truth, frame.timestamp)
+    k = truth_by_time.nearest(frame.timestamp)
     errors.append(ellreloc.pose_error(r.pose, truth[k].pose) if r.success and k is not None else None)
 s = ellreloc.summarize(errors)
 print(f"{s.frames} frames: {s.valid_percent:.1f}% valid, median {s.median_position_cm:.1f} cm, "

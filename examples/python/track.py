@@ -35,8 +35,9 @@ monocular = ellreloc.TrackRelocalizer(relocalizer, max_frames=length, metric_odo
 unit = 0.37  # metres per unit of the monocular odometry
 rows = {"alone": [], "along the track": [], "along the track of a monocular odometry": []}
 wrong = {name: 0 for name in rows}
+truth_by_time = ellreloc.time_index(truth)
 for frame in frames:
-    k = ellreloc.find_nearest(truth, frame.timestamp)
+    k = truth_by_time.nearest(frame.timestamp)
     if k is None:  # no odometry pose: the track starts again
         track.reset()
         monocular.reset()
