@@ -41,6 +41,10 @@ CLI::App* addEvaluateCommand(CLI::App& app, EvaluateArgs& a) {
 
 namespace {
 
+/// An estimate's pose belongs to a query frame when their times are this close (seconds):
+/// `ellreloc relocalize` writes each frame's own timestamp.
+constexpr double kSameTime = 1e-4;
+
 /// FILE:LABEL -> {FILE, LABEL}; an existing file keeps its colons, and the label defaults to
 /// the file's name without extension.
 std::pair<std::string, std::string> fileAndLabel(const std::string& arg) {
@@ -117,18 +121,14 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
   }
   if (e.frames.empty()) throw Error(a.groundtruth + ": no query frame has a ground-truth pose");
   for (size_t g : truth_index) e.truth.push_back(gt[g].pose.center());
-  std::sort(frame_times.begin(), frame_times.end());
-  const auto isFrameTime = [&](double t) {  // within the matching tolerance below
-    const auto it = std::lower_bound(frame_times.begin(), frame_times.end(), t - 1e-4);
-    return it != frame_times.end() && *it <= t + 1e-4;
-  };
+  const io::TimeIndex frames_by_time(frame_times);
   for (const auto& [path, label] : estimates) {
     // An estimate without poses is a run that relocalized nothing: 0% valid, not an error.
     const std::vector<io::StampedPose> est = io::readTumTrajectory(path, /*allow_empty=*/true);
     MethodEvaluation m{label, path, {}, {}, {}};
     const io::TimeIndex by_time = io::timeIndex(est);
     for (size_t i = 0; i < e.frames.size(); ++i) {
-      const auto k = by_time.nearest(times[i], 1e-4);
+      const auto k = by_time.nearest(times[i], kSameTime);
       m.errors.push_back(k ? std::optional(poseError(est[*k].pose, gt[truth_index[i]].pose)) : std::nullopt);
       m.centres.push_back(k ? std::optional(est[*k].pose.center()) : std::nullopt);
     }
@@ -137,7 +137,9 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
     // Poses at no frame's time are left out of every figure: say so, e.g. when the ground truth
     // is a motion-capture trajectory sampled apart from the camera's frames.
     const auto unmatched = static_cast<size_t>(
-        std::count_if(est.begin(), est.end(), [&](const io::StampedPose& p) { return !isFrameTime(p.timestamp); }));
+        std::count_if(est.begin(), est.end(), [&](const io::StampedPose& p) {
+          return !frames_by_time.nearest(p.timestamp, kSameTime);
+        }));
     if (unmatched > 0)
       std::fprintf(stderr, "warning: %s: %zu of its %zu poses are at no frame's time (within 0.1 ms)%s\n", path.c_str(),
                    unmatched, est.size(),
