@@ -490,6 +490,7 @@ class RefinementOptions:
     cost_margin: float
     rounds: int
     regular_mask_sigma: float
+    polish_loss_scale: float
     refiner: RefinerOptions
 
 

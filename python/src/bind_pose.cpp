@@ -245,6 +245,7 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("cost_margin", &RefinementStageOptions::cost_margin)
       .def_readwrite("rounds", &RefinementStageOptions::rounds)
       .def_readwrite("regular_mask_sigma", &RefinementStageOptions::regular_mask_sigma)
+      .def_readwrite("polish_loss_scale", &RefinementStageOptions::polish_loss_scale)
       .def_readwrite("refiner", &RefinementStageOptions::refiner);
   py::class_<AcceptanceOptions>(m, "AcceptanceOptions")
       .def(py::init<>())

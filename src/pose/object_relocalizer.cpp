@@ -321,6 +321,7 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
   // Past the time budget only the best hypothesis is refined: the bound is the budget plus one refinement.
   ChosenPose chosen =
       refineHypotheses(pool, search.best, scorers, context, budget.timeUp() ? 1 : pool.entries().size());
+  chosen = polishPose(std::move(chosen), scorer, context);
   chosen = refineWithPoints(std::move(chosen), pointMatches(keypoints, map_), scorer, context);
 
   // 4. The result.

@@ -144,6 +144,13 @@ struct RefinementStageOptions {
   /// (docs/benchmarks.md, scene tables); the map's own error, the same for both, brings the
   /// ratio of the whole errors to about 0.7. 1 weighs every observation alike.
   double regular_mask_sigma = 0.7;
+  /// The chosen pose is refined once more on its matches with this Cauchy scale (normalised W2
+  /// units, as RefinerOptions::object_loss_scale) and kept when it explains the observations at
+  /// least as well: the tighter loss lets a few matches that disagree with the rest (a partly
+  /// hidden object, a box of part of one, a misplaced map object) pull the pose less, once the
+  /// matches are settled. The wider `refiner` scale stays for choosing among the hypotheses,
+  /// where a tight loss would let a wrong pose ignore what it does not explain. 0: off.
+  double polish_loss_scale = 0.3;
   RefinerOptions refiner;
 };
 
@@ -241,6 +248,8 @@ struct RelocalizerOptions {
     if (!(refinement.cost_margin >= 0)) return "refinement.cost_margin is negative or not a number";
     if (!(finite(refinement.regular_mask_sigma) && refinement.regular_mask_sigma > 0))
       return "refinement.regular_mask_sigma is not a positive number";
+    if (!(finite(refinement.polish_loss_scale) && refinement.polish_loss_scale >= 0))
+      return "refinement.polish_loss_scale is negative or not finite";
     const RefinerOptions& r = refinement.refiner;
     if (!(finite(r.object_loss_scale) && r.object_loss_scale > 0) ||
         !(finite(r.point_sigma_px) && r.point_sigma_px > 0) ||

@@ -107,6 +107,26 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
   return best;
 }
 
+ChosenPose polishPose(ChosenPose chosen, PoseScorer& scorer, const RefinementContext& c) {
+  const RefinementStageOptions& opt = c.options.refinement;
+  // Three matches at least: with fewer the pose rests on each of them, and none is an outlier.
+  if (!opt.enabled || !(opt.polish_loss_scale > 0) || chosen.matches.size() < 3) return chosen;
+  RefinerOptions tight = opt.refiner;
+  tight.object_loss_scale = opt.polish_loss_scale;
+  const RefinementResult r = refinePose(c.K, chosen.pose, ellipseMatches(chosen.matches, c), {}, tight,
+                                        refinementGravity(c, chosen.matches.size()));
+  if (r.fell_back || !c.gate.admits(r.pose)) return chosen;
+  std::vector<ObjectCorrespondence> rematched;
+  const double cost = scorer.cost(r.pose, kReportIoUVertices, &rematched);
+  if (cost > chosen.cost) return chosen;
+  chosen.margin += chosen.cost - cost;  // the rivals keep their costs
+  chosen.pose = r.pose;
+  chosen.cost = cost;
+  chosen.matches = std::move(rematched);
+  chosen.refined = true;
+  return chosen;
+}
+
 ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& points, PoseScorer& scorer,
                             const RefinementContext& c) {
   if (points.empty() || !c.options.refinement.enabled || chosen.matches.empty()) return chosen;

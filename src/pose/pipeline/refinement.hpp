@@ -47,6 +47,10 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
                             const std::vector<PoseScorer*>& scorers, const RefinementContext& context,
                             size_t max_refined);
 
+/// Refines the chosen pose once more on its matches with the tighter loss of
+/// refinement.polish_loss_scale; keeps the result when it costs no more and stays in the gate.
+ChosenPose polishPose(ChosenPose chosen, PoseScorer& scorer, const RefinementContext& context);
+
 /// Refines the chosen pose again with keypoints matched to map points; keeps the result when it
 /// still explains as many observations.
 ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& points, PoseScorer& scorer,
