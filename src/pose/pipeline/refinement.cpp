@@ -15,6 +15,15 @@ std::optional<GravityPrior> refinementGravity(const RefinementContext& c, size_t
   return matched < 3 || c.options.gravity.in_every_refinement ? c.gravity : std::nullopt;
 }
 
+/// Takes a refined pose, its cost and matches in place of the chosen one's.
+void adopt(const Pose& pose, double cost, std::vector<ObjectCorrespondence> matches, ChosenPose* chosen) {
+  chosen->margin += chosen->cost - cost;  // the rivals keep their costs
+  chosen->pose = pose;
+  chosen->cost = cost;
+  chosen->matches = std::move(matches);
+  chosen->refined = true;
+}
+
 }  // namespace
 
 ChosenPose refineRounds(const Pose& start, PoseScorer& scorer, const RefinementContext& c) {
@@ -118,12 +127,7 @@ ChosenPose polishPose(ChosenPose chosen, PoseScorer& scorer, const RefinementCon
   if (r.fell_back || !c.gate.admits(r.pose)) return chosen;
   std::vector<ObjectCorrespondence> rematched;
   const double cost = scorer.cost(r.pose, kReportIoUVertices, &rematched);
-  if (cost > chosen.cost) return chosen;
-  chosen.margin += chosen.cost - cost;  // the rivals keep their costs
-  chosen.pose = r.pose;
-  chosen.cost = cost;
-  chosen.matches = std::move(rematched);
-  chosen.refined = true;
+  if (cost <= chosen.cost) adopt(r.pose, cost, std::move(rematched), &chosen);
   return chosen;
 }
 
@@ -135,13 +139,8 @@ ChosenPose refineWithPoints(ChosenPose chosen, const std::vector<PointMatch>& po
   if (r.fell_back) return chosen;
   std::vector<ObjectCorrespondence> with_points;
   const double cost = scorer.cost(r.pose, kReportIoUVertices, &with_points);
-  if (with_points.size() >= chosen.matches.size() && c.gate.admits(r.pose)) {
-    chosen.margin += chosen.cost - cost;  // the rivals keep their costs
-    chosen.pose = r.pose;
-    chosen.cost = cost;
-    chosen.matches = std::move(with_points);
-    chosen.refined = true;
-  }
+  if (with_points.size() >= chosen.matches.size() && c.gate.admits(r.pose))
+    adopt(r.pose, cost, std::move(with_points), &chosen);
   return chosen;
 }
 
