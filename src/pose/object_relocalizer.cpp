@@ -246,7 +246,17 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
   const auto start = std::chrono::steady_clock::now();  // the frame's clock: its time budget and time_ms
   const CanonicalFrame frame = inCanonicalOrder(observations);
   RelocalizationResult result =
-      inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity, region, start), frame.order);
+      inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity, region, start, true), frame.order);
+  result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+RelocalizationResult ObjectRelocalizer::relocalizeUnpolished(const std::vector<Observation>& observations,
+                                                             const std::optional<GravityPrior>& gravity) const {
+  const auto start = std::chrono::steady_clock::now();
+  const CanonicalFrame frame = inCanonicalOrder(observations);
+  RelocalizationResult result =
+      inGivenOrder(relocalizeInOrder(frame.observations, {}, gravity, std::nullopt, start, false), frame.order);
   result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -255,7 +265,8 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
                                                           const std::vector<Keypoint>& keypoints,
                                                           const std::optional<GravityPrior>& gravity,
                                                           const std::optional<PoseRegion>& region,
-                                                          std::chrono::steady_clock::time_point start) const {
+                                                          std::chrono::steady_clock::time_point start,
+                                                          bool polish) const {
   RelocalizationResult result;
   const auto finish = [&](RelocalizationStatus status, std::string reason) {
     result.status = status;
@@ -321,7 +332,7 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
   // Past the time budget only the best hypothesis is refined: the bound is the budget plus one refinement.
   ChosenPose chosen =
       refineHypotheses(pool, search.best, scorers, context, budget.timeUp() ? 1 : pool.entries().size());
-  chosen = polishPose(std::move(chosen), scorer, context);
+  if (polish) chosen = polishPose(std::move(chosen), scorer, context);
   chosen = refineWithPoints(std::move(chosen), pointMatches(keypoints, map_), scorer, context);
 
   // 4. The result.

@@ -245,7 +245,7 @@ TrackResult TrackRelocalizer::add(const std::vector<Observation>& observations, 
   };
   if (const std::string bad = options_.validate(); !bad.empty()) return invalid("invalid track options: " + bad);
   if (!odometry_pose.isValid()) return invalid("invalid odometry pose (non-finite, or not a rotation)");
-  out.result = relocalizer_.relocalize(observations, {}, gravity);
+  out.result = relocalizer_.relocalizeUnpolished(observations, gravity);
   if (out.result.status == RelocalizationStatus::InvalidInput) return out;
   join(observations, odometry_pose, out.result);
 

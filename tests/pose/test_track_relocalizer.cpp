@@ -3,9 +3,12 @@
 #include <random>
 
 #include "ellreloc/core/evaluation.hpp"
+#include "ellreloc/observe/observe.hpp"
 #include "ellreloc/pose/object_relocalizer.hpp"
 #include "ellreloc/pose/track_relocalizer.hpp"
 #include "ellreloc/sim/map_observations.hpp"
+#include "ellreloc/sim/noise.hpp"
+#include "ellreloc/sim/render.hpp"
 #include "fixtures/random_geometry.hpp"
 #include "fixtures/twin_desks.hpp"
 
@@ -91,6 +94,38 @@ TEST(TrackRelocalizer, AnEarlierViewOfAUniqueObjectTellsTheLookAlikeDesksApart) 
     // The plant view, carried to the desk view, rules the twin out by what it leaves unexplained.
     EXPECT_GT(r.result.margin, 0.5);
   }
+}
+
+// A track ranks each frame's poses over all of its frames; a pose polished on its own frame
+// (refinement.polish_loss_scale) fits that frame's agreeing matches more tightly and carries to
+// the others worse, so the track takes the frames' poses unpolished: its results are those of a
+// relocalizer without the polish, while single frames differ.
+TEST(TrackRelocalizer, TakesTheFramesPosesUnpolished) {
+  const sim::Scene scene = sim::makeScene(sim::ScenePreset::Office, 5);
+  const sim::NoiseModel noise = sim::NoiseModel::preset(sim::NoiseLevel::Realistic);
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const ObjectMap map = sim::perturbMap(scene.groundTruthMap(), noise, 3);
+  RelocalizerOptions off;
+  off.refinement.polish_loss_scale = 0.0;
+  const ObjectRelocalizer polished(map, K), unpolished(map, K, off);
+  TrackRelocalizer a(polished, TrackOptions{4}), b(unpolished, TrackOptions{4});
+  std::mt19937_64 rng(4);
+  int frames_that_differ_alone = 0, tracked = 0;
+  for (const Pose& truth : sim::queryTrajectory(scene, 12, 4)) {
+    const sim::RenderedFrame frame = sim::render(scene, K, truth);
+    std::vector<Observation> observations;
+    for (const Detection& d : sim::detect(scene, frame, noise, rng))
+      if (const auto r = observeDetection(d, K.width, K.height); r.observation) observations.push_back(*r.observation);
+    const TrackResult ta = a.add(observations, truth), tb = b.add(observations, truth);
+    ASSERT_EQ(ta.result.status, tb.result.status);
+    tracked += ta.result.pose.isValid();
+    EXPECT_TRUE(ta.result.pose.translation() == tb.result.pose.translation() &&
+                ta.result.pose.rotation() == tb.result.pose.rotation());
+    frames_that_differ_alone +=
+        !(polished.relocalize(observations).pose.translation() == unpolished.relocalize(observations).pose.translation());
+  }
+  EXPECT_GE(tracked, 8);
+  EXPECT_GE(frames_that_differ_alone, 3);
 }
 
 TEST(TrackRelocalizer, AFrameWithoutObjectsGetsItsPoseFromTheTrack) {

@@ -164,7 +164,13 @@ class ObjectRelocalizer {
                                          const std::vector<Keypoint>& keypoints,
                                          const std::optional<GravityPrior>& gravity,
                                          const std::optional<PoseRegion>& region,
-                                         std::chrono::steady_clock::time_point start) const;
+                                         std::chrono::steady_clock::time_point start, bool polish) const;
+  // relocalize() without the polish (RefinementStageOptions::polish_loss_scale), for a track: it
+  // ranks each frame's poses over all of its frames, and a pose polished on one frame fits that
+  // frame's agreeing matches more tightly and the other frames worse (docs/pose.md, "Over a track").
+  friend class TrackRelocalizer;
+  RelocalizationResult relocalizeUnpolished(const std::vector<Observation>& observations,
+                                            const std::optional<GravityPrior>& gravity) const;
   RelocalizationResult scorePoseInOrder(const std::vector<Observation>& observations, const Pose& pose) const;
   RelocalizationResult refineFromInOrder(const std::vector<Observation>& observations, const Pose& start) const;
 
