@@ -243,20 +243,22 @@ RelocalizationResult ObjectRelocalizer::relocalize(const std::vector<Observation
                                                    const std::vector<Keypoint>& keypoints,
                                                    const std::optional<GravityPrior>& gravity,
                                                    const std::optional<PoseRegion>& region) const {
-  const auto start = std::chrono::steady_clock::now();  // the frame's clock: its time budget and time_ms
-  const CanonicalFrame frame = inCanonicalOrder(observations);
-  RelocalizationResult result =
-      inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity, region, start, true), frame.order);
-  result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return result;
+  return relocalizeTimed(observations, keypoints, gravity, region, true);
 }
 
 RelocalizationResult ObjectRelocalizer::relocalizeUnpolished(const std::vector<Observation>& observations,
                                                              const std::optional<GravityPrior>& gravity) const {
-  const auto start = std::chrono::steady_clock::now();
+  return relocalizeTimed(observations, {}, gravity, std::nullopt, false);
+}
+
+RelocalizationResult ObjectRelocalizer::relocalizeTimed(const std::vector<Observation>& observations,
+                                                        const std::vector<Keypoint>& keypoints,
+                                                        const std::optional<GravityPrior>& gravity,
+                                                        const std::optional<PoseRegion>& region, bool polish) const {
+  const auto start = std::chrono::steady_clock::now();  // the frame's clock: its time budget and time_ms
   const CanonicalFrame frame = inCanonicalOrder(observations);
   RelocalizationResult result =
-      inGivenOrder(relocalizeInOrder(frame.observations, {}, gravity, std::nullopt, start, false), frame.order);
+      inGivenOrder(relocalizeInOrder(frame.observations, keypoints, gravity, region, start, polish), frame.order);
   result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -97,9 +97,8 @@ TEST(ObjectRelocalizer, ThePolishLetsPartlyHiddenObjectsPullThePoseLess) {
     std::mt19937_64 rng(seed);
     for (const Pose& truth : sim::queryTrajectory(scene, 20, seed)) {
       const sim::RenderedFrame frame = sim::render(scene, K, truth);
-      std::vector<Observation> observations;
-      for (const Detection& d : sim::detect(scene, frame, noise, rng))
-        if (const auto r = observeDetection(d, K.width, K.height); r.observation) observations.push_back(*r.observation);
+      const std::vector<Observation> observations =
+          observeDetections(sim::detect(scene, frame, noise, rng), K.width, K.height);
       const RelocalizationResult a = polished.relocalize(observations), b = unpolished.relocalize(observations);
       ASSERT_EQ(a.status, b.status);
       if (a.status != RelocalizationStatus::Success) continue;
@@ -540,9 +539,8 @@ TEST(ObjectRelocalizer, KeypointsMatchedToMapPointsImproveAccuracy) {
   std::vector<double> without, with;
   for (const Pose& truth : sim::queryTrajectory(scene, 12, 10)) {
     const sim::RenderedFrame frame = sim::render(scene, K, truth);
-    std::vector<Observation> observations;
-    for (const Detection& d : sim::detect(scene, frame, noise, rng))
-      if (const auto r = observeDetection(d, K.width, K.height); r.observation) observations.push_back(*r.observation);
+    const std::vector<Observation> observations =
+        observeDetections(sim::detect(scene, frame, noise, rng), K.width, K.height);
     std::vector<Keypoint> keypoints = sim::keypoints(scene, frame, K, truth, noise, rng);
     const RelocalizationResult a = relocalizer.relocalize(observations);
     const RelocalizationResult b = relocalizer.relocalize(observations, keypoints);

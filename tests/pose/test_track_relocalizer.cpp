@@ -113,9 +113,8 @@ TEST(TrackRelocalizer, TakesTheFramesPosesUnpolished) {
   int frames_that_differ_alone = 0, tracked = 0;
   for (const Pose& truth : sim::queryTrajectory(scene, 12, 4)) {
     const sim::RenderedFrame frame = sim::render(scene, K, truth);
-    std::vector<Observation> observations;
-    for (const Detection& d : sim::detect(scene, frame, noise, rng))
-      if (const auto r = observeDetection(d, K.width, K.height); r.observation) observations.push_back(*r.observation);
+    const std::vector<Observation> observations =
+        observeDetections(sim::detect(scene, frame, noise, rng), K.width, K.height);
     const TrackResult ta = a.add(observations, truth), tb = b.add(observations, truth);
     ASSERT_EQ(ta.result.status, tb.result.status);
     tracked += ta.result.pose.isValid();
