@@ -126,8 +126,10 @@ void map(const MapArgs& a, const Console& console) {
                                   {"--trajectory", a.trajectory},
                                   {"--detections", a.detections},
                                   {"--holdout", a.holdout}});
-  const Intrinsics K = io::readCamera(a.camera);
   MapperOptions options;
+  // With --undistort the camera file is read once, as a lens whose intrinsics are the pinhole image's.
+  if (a.undistort) options.lens = io::readLens(a.camera);
+  const Intrinsics K = options.lens ? options.lens->intrinsics : io::readCamera(a.camera);
   if (!parseMappingMode(a.mode, &options.mode)) throw Error("--mode: unknown mode '" + a.mode + "' (voxel, boxes)");
   if (!a.up.empty()) {
     const Eigen::Vector3d up(a.up[0], a.up[1], a.up[2]);
@@ -135,10 +137,7 @@ void map(const MapArgs& a, const Console& console) {
     options.ellipsoid.up = up.normalized();
     options.boxes.up = up.normalized();
   }
-  if (a.undistort)
-    options.lens = io::readLens(a.camera);
-  else if (!console.quiet)
-    mentionTheLens(a.camera);
+  if (!a.undistort && !console.quiet) mentionTheLens(a.camera);
   const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   std::vector<io::Association> associations;

@@ -394,11 +394,12 @@ std::vector<std::vector<Keypoint>> frameKeypoints(const RelocalizeArgs& a, const
 }
 
 /// How detections become observations: the policy, and with --undistort the camera file's lens.
-ObserveOptions observeOptions(const RelocalizeArgs& a, const std::string& policy, const Console& console) {
+ObserveOptions observeOptions(const RelocalizeArgs& a, const std::string& policy, const std::optional<Lens>& lens,
+                              const Console& console) {
   ObserveOptions o;
   o.policy = parsePolicy(policy.empty() ? "solid" : policy);
+  o.lens = lens;
   if (a.undistort) {
-    o.lens = io::readLens(a.camera);
     if (o.lens->distortion.isZero() && !console.quiet)
       std::printf("%s: no distortion (Camera.k1 ... all 0 or left out): --undistort changes nothing\n",
                   a.camera.c_str());
@@ -570,7 +571,10 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
                                                           {"--near", a.near},
                                                           {"--track", a.track}});
   if (!a.track.empty() && a.use_points) throw Error("--track: keypoints are not used along a track; drop --points");
-  const Intrinsics K = io::readCamera(a.camera);
+  // With --undistort the camera file is read once, as a lens whose intrinsics are the pinhole image's.
+  std::optional<Lens> lens;
+  if (a.undistort) lens = io::readLens(a.camera);
+  const Intrinsics K = lens ? lens->intrinsics : io::readCamera(a.camera);
   std::vector<std::string> left_out;
   const ObjectMap object_map = io::readMap(a.map, &left_out);
   for (const std::string& w : left_out) std::fprintf(stderr, "warning: %s\n", w.c_str());
@@ -582,7 +586,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const std::vector<std::optional<PoseRegion>> regions = nearRegions(a, timestamps, &without_region);
   size_t without_odometry = 0;
   const std::vector<std::optional<Pose>> odometry = trackPoses(a, timestamps, &without_odometry);
-  const ObserveOptions observe_options = observeOptions(a, policy, console);
+  const ObserveOptions observe_options = observeOptions(a, policy, lens, console);
   const ObjectRelocalizer relocalizer(object_map, K, options);
   if (const auto& up = relocalizer.upFromObjects(); up && !console.quiet)
     std::printf(
