@@ -399,7 +399,7 @@ ObserveOptions observeOptions(const RelocalizeArgs& a, const std::string& policy
   ObserveOptions o;
   o.policy = parsePolicy(policy.empty() ? "solid" : policy);
   o.lens = lens;
-  if (a.undistort) {
+  if (o.lens) {
     if (o.lens->distortion.isZero() && !console.quiet)
       std::printf("%s: no distortion (Camera.k1 ... all 0 or left out): --undistort changes nothing\n",
                   a.camera.c_str());

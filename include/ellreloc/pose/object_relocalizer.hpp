@@ -157,15 +157,15 @@ class ObjectRelocalizer {
   const std::optional<MapUp>& upFromObjects() const { return up_from_objects_; }
 
  private:
-  // The public calls above hand these the observations in a canonical order (detection score
-  // first), so that their results do not depend on the order a detector lists its detections
-  // in, and give the results' observation indices back in the order given.
   // relocalize()'s work on the frame's clock (its time budget and time_ms), with or without the
   // polish of the chosen pose.
   RelocalizationResult relocalizeTimed(const std::vector<Observation>& observations,
                                        const std::vector<Keypoint>& keypoints,
                                        const std::optional<GravityPrior>& gravity,
                                        const std::optional<PoseRegion>& region, bool polish) const;
+  // The public calls above hand these the observations in a canonical order (detection score
+  // first), so that their results do not depend on the order a detector lists its detections
+  // in, and give the results' observation indices back in the order given.
   RelocalizationResult relocalizeInOrder(const std::vector<Observation>& observations,
                                          const std::vector<Keypoint>& keypoints,
                                          const std::optional<GravityPrior>& gravity,
