@@ -62,37 +62,36 @@ bool parseNoiseLevel(const std::string& name, NoiseLevel* level) {
 
 namespace {
 
-/// Erodes or dilates a mask by r pixels (a disc), r drawn in [1, max_px].
+/// Erodes or dilates a mask by r pixels (a disc), r drawn in [1, max_px]. The work is done on
+/// the mask's box grown by r: a disc of radius r reaches no pixel beyond it, and where the box
+/// meets the image border the crop's border is the image's, so the result is the whole image's.
 RleMask morphNoise(const RleMask& rle, int max_px, std::mt19937_64& rng) {
-  const auto m = decodeMask(rle);
-  if (!m || max_px <= 0) return rle;
-  cv::Mat img(m->height, m->width, CV_8U, const_cast<uint8_t*>(m->data.data()));
+  if (!rle.isConsistent() || max_px <= 0) return rle;
   const int r = std::uniform_int_distribution<int>(1, max_px)(rng);
+  const bool dilate = std::bernoulli_distribution(0.5)(rng);
+  std::optional<BinaryMask> m = decodeMaskCrop(rle, r);
+  if (!m) return encodeRuns(rle.height, rle.width, [](int, int) { return false; });  // no pixel
+  cv::Mat img(m->height, m->width, CV_8U, m->data.data());
   const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
   cv::Mat out;
-  if (std::bernoulli_distribution(0.5)(rng))
+  if (dilate)
     cv::dilate(img, out, disc);
   else
     cv::erode(img, out, disc);
-  BinaryMask noisy(m->height, m->width);
-  std::copy(out.data, out.data + noisy.data.size(), noisy.data.begin());
-  return encodeMask(noisy);
+  std::copy(out.data, out.data + m->data.size(), m->data.begin());
+  return encodeMask(*m);
 }
 
 /// Toggles round(rate x area) pixels drawn uniformly in the mask's box grown by 2 pixels:
 /// holes inside the object and specks around it, as a segmentation network's pixel errors.
 RleMask flipPixels(const RleMask& rle, double rate, std::mt19937_64& rng) {
-  auto m = decodeMask(rle);
   const auto moments = rleMoments(rle);
+  auto m = decodeMaskCrop(rle, 2);  // the box grown by 2 pixels, cut to the image
   if (!m || !moments || !(rate > 0.0)) return rle;
-  const int x1 = std::max(0, static_cast<int>(moments->bounds.x1 + 0.5) - 2);
-  const int y1 = std::max(0, static_cast<int>(moments->bounds.y1 + 0.5) - 2);
-  const int x2 = std::min(m->width - 1, static_cast<int>(moments->bounds.x2 - 0.5) + 2);
-  const int y2 = std::min(m->height - 1, static_cast<int>(moments->bounds.y2 - 0.5) + 2);
-  std::uniform_int_distribution<int> ux(x1, x2), uy(y1, y2);
+  std::uniform_int_distribution<int> ux(m->x0, m->x0 + m->width - 1), uy(m->y0, m->y0 + m->height - 1);
   for (long k = std::lround(rate * moments->area); k > 0; --k) {
     const int y = uy(rng);  // drawn before x: see drawLastFirst
-    uint8_t& px = m->at(ux(rng), y);
+    uint8_t& px = m->at(ux(rng) - m->x0, y - m->y0);
     px = px ? 0 : 1;
   }
   return encodeMask(*m);
@@ -129,11 +128,13 @@ std::vector<Detection> detect(const Scene& scene, const RenderedFrame& frame, co
   for (int k = noise.false_positives > 0 ? fp(rng) : 0; k > 0; --k) {
     const double w = 20 + 100 * u(rng), h = 20 + 100 * u(rng);
     const double x = (frame.width - w) * u(rng), y = (frame.height - h) * u(rng);
-    BinaryMask m(frame.height, frame.width);
     const Ellipse e({x + w / 2, y + h / 2}, {w / 2, h / 2}, 0.0);
-    for (int yy = static_cast<int>(y); yy < static_cast<int>(y + h) && yy < frame.height; ++yy)
-      for (int xx = static_cast<int>(x); xx < static_cast<int>(x + w) && xx < frame.width; ++xx)
-        m.at(xx, yy) = e.contains({double(xx), double(yy)});
+    const int xa = static_cast<int>(x), xb = std::min(static_cast<int>(x + w), frame.width);
+    const int ya = static_cast<int>(y), yb = std::min(static_cast<int>(y + h), frame.height);
+    BinaryMask m(std::max(yb - ya, 0), std::max(xb - xa, 0));  // a crop of the image: the blob's box
+    m.x0 = xa, m.y0 = ya, m.image_width = frame.width, m.image_height = frame.height;
+    for (int yy = ya; yy < yb; ++yy)
+      for (int xx = xa; xx < xb; ++xx) m.at(xx - xa, yy - ya) = e.contains({double(xx), double(yy)});
     Detection d;
     d.category_id = scene.objects[static_cast<size_t>(u(rng) * scene.objects.size()) % scene.objects.size()].category;
     d.score = 0.3 + 0.4 * u(rng);

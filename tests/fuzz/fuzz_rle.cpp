@@ -23,7 +23,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!mask) return 0;
   FUZZ_CHECK(encodeMask(*mask).totalPixels() == rle.totalPixels());
   (void)rleMoments(rle);
-  (void)decodeMaskCrop(rle);
+  // A crop, grown by any margin, encodes as the whole mask (the canonical runs of its pixels).
+  if (const auto crop = decodeMaskCrop(rle, data[0] % 70))
+    FUZZ_CHECK(encodeMask(*crop).counts == encodeMask(*mask).counts);
   const RegularVerdict v = testRegularMask(rle);
   for (MaskFitMethod m :
        {MaskFitMethod::Moments, MaskFitMethod::Direct, MaskFitMethod::Quadrilateral, MaskFitMethod::Hull}) {

@@ -196,6 +196,60 @@ TEST(Mask, CropDecodingMatchesFullDecoding) {
   EXPECT_FALSE(maskBox(encodeMask(BinaryMask(10, 10))).has_value());
 }
 
+namespace {
+
+// COCO runs written out pixel by pixel: column-major over the whole image, starting with zeros.
+std::vector<uint32_t> runsOfEveryPixel(const BinaryMask& full) {
+  std::vector<uint32_t> runs{0};
+  bool on = false;
+  for (int x = 0; x < full.width; ++x)
+    for (int y = 0; y < full.height; ++y) {
+      if ((full.at(x, y) != 0) != on) on = !on, runs.push_back(0);
+      ++runs.back();
+    }
+  return runs;
+}
+
+}  // namespace
+
+TEST(Mask, CropsGrownByAMarginEncodeAsTheWholeImage) {
+  // Random specks and blocks in images of random sizes, some touching the border; crops grown by
+  // margins from none to wider than the image: the runs of each crop are those of a scan of
+  // every pixel, and its pixels are the whole mask's inside the crop (nothing set outside).
+  std::mt19937 rng(17);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int W = std::uniform_int_distribution<int>(1, 40)(rng), H = std::uniform_int_distribution<int>(1, 30)(rng);
+    BinaryMask full(H, W);
+    const auto draw = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const int x0 = draw(0, W - 1), y0 = draw(0, H - 1);
+    const int x1 = draw(x0, W - 1), y1 = draw(y0, H - 1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) full.at(x, y) = std::bernoulli_distribution(trial % 3 == 0 ? 1.0 : 0.4)(rng);
+    full.at(x0, y0) = 1;
+    const RleMask rle{H, W, runsOfEveryPixel(full)};
+    ASSERT_EQ(encodeMask(full).counts, rle.counts) << trial;
+    const PixelBounds b = *maskPixelBounds(rle);
+    for (int margin : {0, 1, 3, 50}) {
+      const BinaryMask crop = *decodeMaskCrop(rle, margin);
+      EXPECT_EQ(crop.x0, std::max(b.xmin - margin, 0)) << trial;
+      EXPECT_EQ(crop.y0, std::max(b.ymin - margin, 0)) << trial;
+      EXPECT_EQ(crop.x0 + crop.width - 1, std::min(b.xmax + margin, W - 1)) << trial;
+      EXPECT_EQ(crop.y0 + crop.height - 1, std::min(b.ymax + margin, H - 1)) << trial;
+      EXPECT_EQ(crop.count(), full.count()) << trial;
+      for (int y = 0; y < crop.height; ++y)
+        for (int x = 0; x < crop.width; ++x) ASSERT_EQ(crop.at(x, y), full.at(crop.x0 + x, crop.y0 + y)) << trial;
+      EXPECT_EQ(encodeMask(crop).counts, rle.counts) << trial << " margin " << margin;
+    }
+  }
+  // A window wider than the image, or outside it, is cut to it.
+  BinaryMask one(4, 5);
+  one.at(2, 1) = 1;
+  const auto set = [&](int x, int y) { return one.at(x, y) != 0; };
+  EXPECT_EQ(encodeRunsInWindow(4, 5, -3, 9, -2, 7, set).counts, runsOfEveryPixel(one));
+  EXPECT_EQ(encodeRunsInWindow(4, 5, 7, 9, 0, 4, set).counts, std::vector<uint32_t>{20});
+  EXPECT_EQ(encodeRunsInWindow(4, 5, 2, 3, 1, 2, set).counts, (std::vector<uint32_t>{9, 1, 10}));
+}
+
 TEST(Mask, PolygonMaskEqualsPixelCentreRasterisation) {
   // Random star-shaped (concave) polygons with non-integer vertices, some crossing the image
   // border, against the row-wise ray-casting rasteriser of the fixtures.

@@ -78,13 +78,16 @@ inline std::optional<Box> maskBox(const RleMask& rle) {
   return Box(b->xmin - 0.5, b->ymin - 0.5, b->xmax + 0.5, b->ymax + 0.5);
 }
 
-/// Decodes only the bounding box of a run-length mask's pixels, as a crop (BinaryMask::x0, y0):
-/// the work is proportional to the object, not to the image. nullopt when inconsistent or empty.
-inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle) {
+/// Decodes only the bounding box of a run-length mask's pixels, grown by `margin` pixels on
+/// every side and cut to the image, as a crop (BinaryMask::x0, y0): the work is proportional to
+/// the object, not to the image. nullopt when inconsistent or empty.
+inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle, int margin = 0) {
   const std::optional<PixelBounds> bounds = maskPixelBounds(rle);
   if (!bounds) return std::nullopt;
+  margin = std::clamp(margin, 0, std::max(rle.width, rle.height));  // no overflow below
   // Plain copies, not a structured binding: C++17 lambdas cannot capture those.
-  const int xmin = bounds->xmin, xmax = bounds->xmax, ymin = bounds->ymin, ymax = bounds->ymax;
+  const int xmin = std::max(bounds->xmin - margin, 0), xmax = std::min(bounds->xmax + margin, rle.width - 1);
+  const int ymin = std::max(bounds->ymin - margin, 0), ymax = std::min(bounds->ymax + margin, rle.height - 1);
   BinaryMask m(ymax - ymin + 1, xmax - xmin + 1);
   m.x0 = xmin;
   m.y0 = ymin;
@@ -96,12 +99,11 @@ inline std::optional<BinaryMask> decodeMaskCrop(const RleMask& rle) {
   return m;
 }
 
-/// Encodes a mask (of the whole image, for a crop) as COCO run lengths.
+/// Encodes a mask (of the whole image, for a crop) as COCO run lengths. Only the crop's pixels
+/// are visited: the runs beyond it are counted, not scanned.
 inline RleMask encodeMask(const BinaryMask& m) {
-  return encodeRuns(m.image_height, m.image_width, [&m](int x, int y) {
-    const int lx = x - m.x0, ly = y - m.y0;
-    return m.inside(lx, ly) && m.at(lx, ly) != 0;
-  });
+  return encodeRunsInWindow(m.image_height, m.image_width, m.x0, m.x0 + m.width, m.y0, m.y0 + m.height,
+                            [&m](int x, int y) { return m.at(x - m.x0, y - m.y0) != 0; });
 }
 
 /// The run-length mask of a polygon (even-odd rule): pixel (x, y) is set when its centre lies

@@ -55,27 +55,45 @@ void forEachRunSegment(const RleMask& rle, F f) {
   }
 }
 
+/// The COCO run lengths of a height x width mask whose pixels outside columns [x_begin, x_end)
+/// and rows [y_begin, y_end) are unset, and whose pixel (x, y) inside them is set when
+/// is_set(x, y): only that window is visited, in column-major order, once each (the work is the
+/// window's, not the image's). The window is cut to the image.
+template <typename IsSet>
+RleMask encodeRunsInWindow(int height, int width, int x_begin, int x_end, int y_begin, int y_end, IsSet is_set) {
+  RleMask rle;
+  rle.height = height;
+  rle.width = width;
+  height = std::max(height, 0), width = std::max(width, 0);
+  x_begin = std::clamp(x_begin, 0, width), x_end = std::clamp(x_end, x_begin, width);
+  y_begin = std::clamp(y_begin, 0, height), y_end = std::clamp(y_end, y_begin, height);
+  bool current = false;
+  uint32_t run = 0;
+  const auto add = [&](bool on, uint64_t count) {
+    if (count == 0) return;
+    if (on != current) {
+      rle.counts.push_back(run);
+      run = 0;
+      current = on;
+    }
+    run += static_cast<uint32_t>(count);
+  };
+  add(false, static_cast<uint64_t>(x_begin) * static_cast<uint64_t>(height));
+  for (int x = x_begin; x < x_end; ++x) {
+    add(false, static_cast<uint64_t>(y_begin));
+    for (int y = y_begin; y < y_end; ++y) add(is_set(x, y), 1);
+    add(false, static_cast<uint64_t>(height - y_end));
+  }
+  add(false, static_cast<uint64_t>(width - x_end) * static_cast<uint64_t>(height));
+  rle.counts.push_back(run);
+  return rle;
+}
+
 /// The COCO run lengths of a height x width mask whose pixel (x, y) is set when is_set(x, y):
 /// the pixels are visited in column-major order, once each.
 template <typename IsSet>
 RleMask encodeRuns(int height, int width, IsSet is_set) {
-  RleMask rle;
-  rle.height = height;
-  rle.width = width;
-  bool current = false;
-  uint32_t run = 0;
-  for (int x = 0; x < width; ++x)
-    for (int y = 0; y < height; ++y) {
-      const bool on = is_set(x, y);
-      if (on != current) {
-        rle.counts.push_back(run);
-        run = 0;
-        current = on;
-      }
-      ++run;
-    }
-  rle.counts.push_back(run);
-  return rle;
+  return encodeRunsInWindow(height, width, 0, width, 0, height, is_set);
 }
 
 /// Encodes run lengths as pycocotools' compressed string.
