@@ -217,10 +217,10 @@ TEST(Mask, CropsGrownByAMarginEncodeAsTheWholeImage) {
   // margins from none to wider than the image: the runs of each crop are those of a scan of
   // every pixel, and its pixels are the whole mask's inside the crop (nothing set outside).
   std::mt19937 rng(17);
+  const auto draw = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   for (int trial = 0; trial < 300; ++trial) {
-    const int W = std::uniform_int_distribution<int>(1, 40)(rng), H = std::uniform_int_distribution<int>(1, 30)(rng);
+    const int W = draw(1, 40), H = draw(1, 30);
     BinaryMask full(H, W);
-    const auto draw = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     const int x0 = draw(0, W - 1), y0 = draw(0, H - 1);
     const int x1 = draw(x0, W - 1), y1 = draw(y0, H - 1);
     for (int y = y0; y <= y1; ++y)
