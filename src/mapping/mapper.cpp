@@ -48,10 +48,15 @@ RleMask pinholeMask(const RleMask& raw, const std::vector<int>& raw_pixel, const
       crop ? lens.undistortBox(
                  Box(crop->x0 - 0.5, crop->y0 - 0.5, crop->x0 + crop->width - 0.5, crop->y0 + crop->height - 0.5))
            : std::nullopt;
-  if (!region) return encodeRuns(raw.height, raw.width, [](int, int) { return false; });
-  const double x1 = region->x1 - 1, y1 = region->y1 - 1, x2 = region->x2 + 1, y2 = region->y2 + 1;
-  return encodeRuns(raw.height, raw.width, [&](int x, int y) {
-    if (x < x1 || x > x2 || y < y1 || y > y2) return false;
+  const auto unset = [](int, int) { return false; };
+  if (!region) return encodeRunsInWindow(raw.height, raw.width, 0, 0, 0, 0, unset);
+  // The window: pixels within the outline's bounds; clamped before the cast (the encoder cuts it
+  // to the image).
+  const auto first = [](double v, int size) { return static_cast<int>(std::ceil(std::clamp(v, -1.0, size + 1.0))); };
+  const auto end = [](double v, int size) { return static_cast<int>(std::floor(std::clamp(v, -1.0, size + 1.0))) + 1; };
+  const int x_begin = first(region->x1 - 1, raw.width), x_end = end(region->x2 + 1, raw.width);
+  const int y_begin = first(region->y1 - 1, raw.height), y_end = end(region->y2 + 1, raw.height);
+  return encodeRunsInWindow(raw.height, raw.width, x_begin, x_end, y_begin, y_end, [&](int x, int y) {
     const int r = raw_pixel[static_cast<size_t>(y) * raw.width + x];
     if (r < 0) return false;
     const int lx = r % raw.width - crop->x0, ly = r / raw.width - crop->y0;
