@@ -48,8 +48,7 @@ RleMask pinholeMask(const RleMask& raw, const std::vector<int>& raw_pixel, const
       crop ? lens.undistortBox(
                  Box(crop->x0 - 0.5, crop->y0 - 0.5, crop->x0 + crop->width - 0.5, crop->y0 + crop->height - 0.5))
            : std::nullopt;
-  const auto unset = [](int, int) { return false; };
-  if (!region) return encodeRunsInWindow(raw.height, raw.width, 0, 0, 0, 0, unset);
+  if (!region) return emptyRle(raw.height, raw.width);
   // The window: pixels within the outline's bounds; clamped before the cast (the encoder cuts it
   // to the image).
   const auto first = [](double v, int size) { return static_cast<int>(std::ceil(std::clamp(v, -1.0, size + 1.0))); };

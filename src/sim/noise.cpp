@@ -70,7 +70,7 @@ RleMask morphNoise(const RleMask& rle, int max_px, std::mt19937_64& rng) {
   const int r = std::uniform_int_distribution<int>(1, max_px)(rng);
   const bool dilate = std::bernoulli_distribution(0.5)(rng);
   std::optional<BinaryMask> m = decodeMaskCrop(rle, r);
-  if (!m) return encodeRuns(rle.height, rle.width, [](int, int) { return false; });  // no pixel
+  if (!m) return emptyRle(rle.height, rle.width);  // no pixel
   cv::Mat img(m->height, m->width, CV_8U, m->data.data());
   const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
   cv::Mat out;

@@ -248,6 +248,11 @@ TEST(Mask, CropsGrownByAMarginEncodeAsTheWholeImage) {
   EXPECT_EQ(encodeRunsInWindow(4, 5, -3, 9, -2, 7, set).counts, runsOfEveryPixel(one));
   EXPECT_EQ(encodeRunsInWindow(4, 5, 7, 9, 0, 4, set).counts, std::vector<uint32_t>{20});
   EXPECT_EQ(encodeRunsInWindow(4, 5, 2, 3, 1, 2, set).counts, (std::vector<uint32_t>{9, 1, 10}));
+  // An empty mask: one run of zeros over the image, as a scan of every pixel gives.
+  for (const auto& [h, w] : {std::pair(4, 5), std::pair(480, 640), std::pair(1, 1)}) {
+    EXPECT_EQ(emptyRle(h, w).counts, runsOfEveryPixel(BinaryMask(h, w))) << h << "x" << w;
+    EXPECT_TRUE(emptyRle(h, w).isConsistent()) << h << "x" << w;
+  }
 }
 
 TEST(Mask, PolygonMaskEqualsPixelCentreRasterisation) {

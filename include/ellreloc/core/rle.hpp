@@ -89,6 +89,11 @@ RleMask encodeRunsInWindow(int height, int width, int x_begin, int x_end, int y_
   return rle;
 }
 
+/// The COCO run lengths of a height x width mask with no pixel set (no pixel is visited).
+inline RleMask emptyRle(int height, int width) {
+  return encodeRunsInWindow(height, width, 0, 0, 0, 0, [](int, int) { return false; });
+}
+
 /// The COCO run lengths of a height x width mask whose pixel (x, y) is set when is_set(x, y):
 /// the pixels are visited in column-major order, once each.
 template <typename IsSet>
