@@ -6,12 +6,12 @@ instance masks, or from boxes and poses. Poses are world->camera (Pose.T_cw); TU
 RelocalizationResult.T_wc are camera->world. docs/python.md walks through it.
 """
 
-import sys
+import sys as _sys  # private names: `dir(ellreloc)` lists the library only
 
 try:
-    import numpy  # noqa: F401  (the extension passes numpy arrays: without it, it cannot load)
+    import numpy as _numpy  # noqa: F401  (the extension passes numpy arrays: without it, it cannot load)
 except ImportError as missing:
-    raise ImportError(f"ellreloc needs numpy, which {sys.executable} cannot import; the package was built for "
+    raise ImportError(f"ellreloc needs numpy, which {_sys.executable} cannot import; the package was built for "
                       f"@Python3_EXECUTABLE@ (Python @Python3_VERSION@): run that interpreter, or install numpy "
                       f"for this one") from missing
 

@@ -65,6 +65,20 @@ def test_stub_classes_list_every_member():
             assert not missing, f"{stub}: {name} lacks {sorted(missing)}"
 
 
+def test_the_package_lists_the_library_and_no_module_it_imports():
+    modules = {n for n in dir(ellreloc) if not n.startswith("_") and inspect.ismodule(getattr(ellreloc, n))}
+    assert modules == {"sim"}
+    assert public(ellreloc) == public(_ellreloc)
+
+
+def test_without_numpy_the_import_says_what_is_missing():
+    env = dict(os.environ, PYTHONPATH=str(PACKAGE.parent))
+    run = subprocess.run([sys.executable, "-c", "import sys; sys.modules['numpy'] = None; import ellreloc"],
+                         capture_output=True, text=True, env=env)
+    assert run.returncode != 0
+    assert f"ellreloc needs numpy, which {sys.executable} cannot import" in run.stderr.splitlines()[-1]
+
+
 def test_every_class_function_and_method_is_exercised_by_a_test():
     """Each public class, function and method is named in some test (fields are covered by the
     option round trips of test_surface.py)."""
