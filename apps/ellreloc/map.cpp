@@ -23,6 +23,9 @@ namespace ellreloc::cli {
 
 namespace {
 
+/// "1 object", "2 objects".
+std::string counted(size_t n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
+
 /// The frames that have a pose in the trajectory, with that pose; with a lens, their boxes
 /// undistorted (one that cannot be, far outside the image, is left out).
 std::vector<PosedDetections> posedFrames(const std::vector<DetectionFrame>& frames,
@@ -205,8 +208,9 @@ void map(const MapArgs& a, const Console& console) {
     // Boxes mode reads no depth: only voxel mode can miss one.
     const std::string no_depth_text =
         options.mode == MappingMode::Voxel ? ", " + std::to_string(no_depth) + " without depth" : "";
-    std::printf("wrote %s: %zu objects from %d keyframes (%s mode; %d frames without pose%s)\n", a.out.c_str(),
-                result.objects.size(), used, a.mode.c_str(), no_pose, no_depth_text.c_str());
+    std::printf("wrote %s: %s from %s (%s mode; %s without pose%s)\n", a.out.c_str(),
+                counted(result.objects.size(), "object").c_str(), counted(used, "keyframe").c_str(), a.mode.c_str(),
+                counted(no_pose, "frame").c_str(), no_depth_text.c_str());
     printSummary(result, dropped, mapper.stats(), options.min_observations);
   }
   if (!a.holdout.empty() || a.holdout_every > 0) printQuality(measureMapQuality(result, K, held_out));

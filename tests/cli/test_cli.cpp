@@ -300,6 +300,28 @@ TEST(Cli, Fr3BoxesMapAndRelocalizationStayAboveTheMeasuredFloors) {
   EXPECT_GE(valid[1], valid[3]);  // without the map's envelope: 85.3%, 11 wrong
 }
 
+// Real RGB-D frames (58 of TUM fr3/cabinet, one cabinet, YOLO boxes without masks) in both
+// modes: one object where the data's README fits it to the boxes, centre (-1.53, 0.46, 0.23) m.
+TEST(Cli, Fr3CabinetMapsItsOneObjectInBothModes) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr3_cabinet");
+  for (const std::string mode : {"voxel", "boxes"}) {
+    const CliRun r = run("map --camera " + d + "/camera.yaml --associations " + d + "/associate.txt --trajectory " + d +
+                             "/groundtruth.txt --detections " + d + "/detections.json --mode " + mode + " --out " +
+                             dir.path(mode + ".json"),
+                         dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find(": 1 object from 58 keyframes (" + mode + " mode; 0 frames without pose"), std::string::npos)
+        << r.out;
+    const ellreloc::ObjectMap map = ellreloc::io::readMap(dir.path(mode + ".json"));
+    ASSERT_EQ(map.objects.size(), 1u);
+    EXPECT_EQ(map.objects[0].category, 28);  // suitcase in COCO-80: YOLO has no cabinet
+    // Measured 1 cm for boxes; 10 cm for voxels, whose box-as-mask takes in floor and wall.
+    const double off = (map.objects[0].ellipsoid.center() - Eigen::Vector3d(-1.53, 0.46, 0.23)).norm();
+    EXPECT_LT(off, mode == "boxes" ? 0.05 : 0.2) << mode;
+  }
+}
+
 // A map object with a collapsed axis is left out with a warning naming it; the run goes on.
 TEST(Cli, DegenerateMapObjectsAreReportedAndLeftOut) {
   ellreloc::test::TempDir dir;
