@@ -28,8 +28,7 @@ struct BoxW2Cost {
 
   // Flattened: every Jet operation inlined. Left to itself GCC calls Eigen's 9-vector kernels
   // of the Jets out of line, which cost half of a box map's time. The constants (P, base,
-  // scale) stay plain numbers: a number times a Jet gives the same values as a Jet without
-  // derivatives times a Jet, for a fraction of the work.
+  // scale) stay plain numbers (projectDualQuadric says why).
   template <typename T>
   [[gnu::flatten]] bool operator()(const T* c, const T* s, const T* w, T* residual) const {
     T R_data[9];
@@ -47,7 +46,7 @@ struct BoxW2Cost {
     Q.template topRightCorner<3, 1>() = -centre;
     Q.template bottomLeftCorner<1, 3>() = -centre.transpose();
     Q(3, 3) = T(-1.0);
-    const Mat3<T> C = P * Q * P.transpose();
+    const Mat3<T> C = projectDualQuadric<double, T>(P, Q);
     Vec2<T> mean;
     Mat2<T> cov;
     gaussianFromDualConic<T>(C, &mean, &cov);

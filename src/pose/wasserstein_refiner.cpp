@@ -183,8 +183,7 @@ struct CeresObjectCost {
         K(K.K()),
         inv_scale(1.0 / scale) {}
   /// Flattened, as normalEquations: GCC calls Eigen's kernels for the Jets out of line. K, Q and
-  /// the scale stay plain numbers: a number times a Jet gives the same values as a Jet without
-  /// derivatives times a Jet, for a fraction of the work.
+  /// the scale stay plain numbers (projectDualQuadric says why).
   template <typename T>
   [[gnu::flatten]] bool operator()(const T* q, const T* t, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> quat(q);
@@ -197,7 +196,7 @@ struct CeresObjectCost {
     Eigen::Matrix<T, 3, 4> P;
     P << R, tt;
     P = K * P;
-    const Mat3<T> C = P * Q * P.transpose();
+    const Mat3<T> C = projectDualQuadric<T, double>(P, Q);
     Vec2<T> m;
     Mat2<T> S;
     gaussianFromDualConic<T>(C, &m, &S);

@@ -651,12 +651,12 @@ TEST(Mapper, VoxelKeyframesOfARawImageAreUndistortedWithTheLens) {
     std::vector<double> d, size;
     for (const MapObject& p : pinhole.objects) {
       const MapObject* nearest = nullptr;
+      double distance = INFINITY;
       for (const MapObject& o : map.objects)
-        if (!nearest || (o.ellipsoid.center() - p.ellipsoid.center()).norm() <
-                            (nearest->ellipsoid.center() - p.ellipsoid.center()).norm())
-          nearest = &o;
+        if (const double to_o = (o.ellipsoid.center() - p.ellipsoid.center()).norm(); to_o < distance)
+          nearest = &o, distance = to_o;
       if (!nearest) return std::pair(1e9, 1e9);
-      d.push_back((nearest->ellipsoid.center() - p.ellipsoid.center()).norm());
+      d.push_back(distance);
       size.push_back(std::abs(nearest->ellipsoid.axes().sum() / p.ellipsoid.axes().sum() - 1));
     }
     return std::pair(median(d), median(size));
