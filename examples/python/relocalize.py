@@ -21,8 +21,9 @@ camera = ellreloc.read_camera(data / "camera.yaml")
 world = ellreloc.read_map(data / "map.json")
 frames = ellreloc.read_detections(data / "keyframes.detections.json")
 
-# One relocalizer per map: it observes each frame's detections (the paper's policy: regular
-# masks fitted, other detections as box-inscribed ellipses) and searches, scores and refines.
+# One relocalizer per map: it observes each frame's detections (the 'solid' policy: masks
+# fitted where their shape allows, other detections as box-inscribed ellipses; fr2's keyframes
+# have boxes only) and searches, scores and refines.
 relocalizer = ellreloc.ObjectRelocalizer(world, camera)
 frame = frames[index]
 result = relocalizer.relocalize(frame)

@@ -53,4 +53,4 @@ for frame in frames:
 for name, errors in rows.items():
     s = ellreloc.summarize(errors)
     print(f"{name}: {s.frames} frames, {s.valid_percent:.1f}% valid, median {s.median_position_cm:.1f} cm, "
-          f"{s.median_rotation_deg:.2f} deg, {wrong[name]} wrong poses reported")
+          f"{s.median_rotation_deg:.2f} deg, {wrong[name]} wrong pose{'' if wrong[name] == 1 else 's'} reported")
