@@ -146,6 +146,11 @@ void bindMapperClass(py::module_& m) {
           "uint16 in depth_scale units per metre (TUM: 5000) or float metres. On error the map is unchanged.")
       .def("finish", &Mapper::finish, py::call_guard<py::gil_scoped_release>(),
            "Boxes mode: refits every object whose views grew. Call after the last keyframe.")
+      .def("update_keyframe_poses", &Mapper::updateKeyframePoses, py::call_guard<py::gil_scoped_release>(),
+           py::arg("poses"),
+           "The host moved its keyframes (bundle adjustment, loop closure): the world->camera pose of every "
+           "keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves "
+           "each object with the keyframe that saw it last. On error the map is unchanged.")
       .def("map", &Mapper::map, py::call_guard<py::gil_scoped_release>(), "The current object map.")
       .def_property_readonly("stats", &Mapper::stats)
       .def_property_readonly("camera", &Mapper::intrinsics)

@@ -195,6 +195,33 @@ def test_box_mapping_through_a_lens_equals_the_command_line(data_dir, cli, tmp_p
     assert (tmp_path / "raw.json").read_bytes() != (tmp_path / "cli.json").read_bytes()
 
 
+def test_a_box_map_is_fitted_again_at_the_keyframes_new_poses(data_dir, tmp_path):
+    """Real fr3 boxes mapped from poses whose world origin is elsewhere (the same tracks), then
+    given the poses in this frame: the map the poses in this frame make, byte for byte."""
+    d = data_dir / "tum_fr3_office_first_half"
+    camera, truth = E.read_camera(d / "camera.yaml"), E.read_trajectory(d / "groundtruth.txt")
+    keyframes = []
+    for f in E.read_detections(d / "detections.json")[:600:4]:
+        k = E.find_nearest(truth, f.timestamp)
+        if k is not None:
+            keyframes.append((truth[k].pose, f.detections))
+    shift = np.array([0.5, -1.0, 0.25])
+    here, there = E.Mapper(camera, mode="boxes"), E.Mapper(camera, mode="boxes")
+    for pose, detections in keyframes:
+        here.add_keyframe(pose, detections)
+        there.add_keyframe(E.Pose(pose.R_cw, pose.t_cw + pose.R_cw @ shift), detections)
+    here.finish()
+    there.finish()
+    E.write_map(tmp_path / "here.json", here.map())
+    E.write_map(tmp_path / "there.json", there.map())
+    assert (tmp_path / "there.json").read_bytes() != (tmp_path / "here.json").read_bytes()
+    with pytest.raises(ValueError, match="1 keyframe pose.s. given for %d keyframe" % len(keyframes)):
+        there.update_keyframe_poses([keyframes[0][0]])
+    there.update_keyframe_poses([pose for pose, _ in keyframes])
+    E.write_map(tmp_path / "there.json", there.map())
+    assert (tmp_path / "there.json").read_bytes() == (tmp_path / "here.json").read_bytes()
+
+
 def test_a_mapped_map_keeps_the_relocalizer_where_it_was_made(data_dir, tmp_path):
     d = data_dir / "tum_fr3_office_first_half"
     camera, truth = E.read_camera(d / "camera.yaml"), E.read_trajectory(d / "groundtruth.txt")

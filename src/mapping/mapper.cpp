@@ -236,7 +236,10 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
     FloorOptions floor = options_.floor;
     floor.prior_up = options_.ellipsoid.up;
     floor.seed = options_.floor.seed + static_cast<uint64_t>(keyframes_);
-    if (const auto plane = estimateFloor(K_, pose, *depth, floor)) floor_normal_sum_ += plane->inlier_share * plane->up;
+    if (const auto plane = estimateFloor(K_, pose, *depth, floor)) {
+      floor_normal_sum_ += plane->inlier_share * plane->up;
+      floor_in_camera_.emplace_back(keyframes_, pose.rotation() * (plane->inlier_share * plane->up));
+    }
   }
   std::vector<Detection> ordered = inCanonicalOrder(detections);
   std::vector<bool> cut;  // by the raw image's border, for boxes undistorted from it
@@ -277,6 +280,33 @@ void Mapper::finish() {
   std::unique_lock lock(mutex_);
   for (Track& t : tracks_)
     if (t.confirmed && options_.mode == MappingMode::Boxes && t.built_views != t.views.size()) rebuild(t);
+}
+
+void Mapper::updateKeyframePoses(const std::vector<Pose>& poses) {
+  std::unique_lock lock(mutex_);
+  if (poses.size() != keyframe_poses_.size())
+    throw Error("mapper: " + std::to_string(poses.size()) + " keyframe pose(s) given for " +
+                std::to_string(keyframe_poses_.size()) + " keyframe(s) added");
+  for (size_t k = 0; k < poses.size(); ++k)
+    if (!poses[k].isValid())
+      throw Error("mapper: " + keyframeText(static_cast<int>(k)) + ": pose is not a finite rigid transform");
+  if (options_.mode == MappingMode::Voxel && !floor_in_camera_.empty()) {
+    floor_normal_sum_.setZero();
+    for (const auto& [keyframe, normal] : floor_in_camera_)
+      floor_normal_sum_ += poses[static_cast<size_t>(keyframe)].rotation().transpose() * normal;
+  }
+  for (Track& t : tracks_) {
+    if (options_.mode == MappingMode::Boxes) {
+      for (size_t k = 0; k < t.views.size(); ++k) t.views[k].pose = poses[static_cast<size_t>(t.view_keyframes[k])];
+    } else if (t.last_seen >= 0) {
+      // A point that keyframe saw keeps its place in that camera's frame.
+      const size_t anchor = static_cast<size_t>(t.last_seen);
+      const Pose moved = poses[anchor].inverse() * keyframe_poses_[anchor];
+      t.voxels.moveRigidly(moved.rotation(), moved.translation());
+    }
+    if (t.confirmed) rebuild(t);
+  }
+  keyframe_poses_ = poses;
 }
 
 void Mapper::rebuild(Track& track) const {
@@ -505,6 +535,7 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
       ++report->new_objects;
     }
     t->views.push_back({pose, d.bbox, cut.empty() ? std::nullopt : std::optional<bool>(cut[used[k]])});
+    t->view_keyframes.push_back(keyframes_);
     t->keyframes_seen.push_back(keyframes_);
     observed(*t, d);
   }
@@ -536,6 +567,7 @@ void Mapper::mergeDuplicateBoxTracks() {
       const double reach = std::min(ea.axes().mean(), eb.axes().mean());
       if ((ea.center() - eb.center()).norm() > reach || detected_together(a, b)) continue;
       a.views.insert(a.views.end(), b.views.begin(), b.views.end());
+      a.view_keyframes.insert(a.view_keyframes.end(), b.view_keyframes.begin(), b.view_keyframes.end());
       std::vector<int> seen;
       std::merge(a.keyframes_seen.begin(), a.keyframes_seen.end(), b.keyframes_seen.begin(), b.keyframes_seen.end(),
                  std::back_inserter(seen));

@@ -281,6 +281,25 @@ void VoxelObject::absorb(const VoxelObject& other) {
   enforceBudget();
 }
 
+void VoxelObject::moveRigidly(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  std::vector<uint64_t> old_keys;
+  std::vector<Voxel> old_voxels;
+  old_keys.swap(keys_);
+  old_voxels.swap(voxels_);
+  slots_.clear();
+  for (size_t i = 0; i < old_keys.size(); ++i) {
+    const Voxel& before = old_voxels[i];
+    const Eigen::Vector3d x = R * pointMeanOf(old_keys[i], before) + t;
+    const std::optional<uint64_t> key = keyOf(x);
+    if (!key) continue;
+    bool added = false;
+    Voxel& v = voxels_[indexOrAdd(*key, &added)];
+    v.log_odds = added ? before.log_odds : std::max(v.log_odds, before.log_odds);
+    v.stamp = added ? before.stamp : std::max(v.stamp, before.stamp);
+    addToMean(v, (x - centreOf(*key)) / options_.voxel_size, std::max<long>(1, before.points));
+  }
+}
+
 size_t VoxelObject::occupiedCount() const {
   size_t n = 0;
   for (const Voxel& v : voxels_) n += occupied(v);

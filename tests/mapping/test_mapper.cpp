@@ -175,13 +175,22 @@ TEST(Mapper, ASecondModelOfOneObjectJoinsTheFirst) {
   EXPECT_EQ(mapper.objects()[0].observations, 14);  // every detection counts once
 }
 
-TEST(Mapper, BoxesOnlyMode) {
+/// 30 keyframes of the sparse scene with boxes jittered by a pixel, for boxes mode.
+test::SimSequence boxSequence() {
   sim::NoiseModel noise;
   noise.box_jitter_px = 1.0;
-  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 4, 30, noise);
+  return test::makeSimSequence(sim::ScenePreset::Sparse, 4, 30, noise);
+}
+
+MapperOptions boxesMode() {
   MapperOptions opt;
   opt.mode = MappingMode::Boxes;
-  Mapper mapper(seq.K, opt);
+  return opt;
+}
+
+TEST(Mapper, BoxesOnlyMode) {
+  const test::SimSequence seq = boxSequence();
+  Mapper mapper(seq.K, boxesMode());
   std::vector<int> seen(seq.scene.objects.size(), 0);
   for (const auto& kf : seq.keyframes) {
     mapper.addKeyframe(kf.pose, kf.detections);  // no depth needed
@@ -502,6 +511,138 @@ TEST(Mapper, BadKeyframesAreErrorsAndLeaveTheMapUnchanged) {
   EXPECT_EQ(after.keyframes, before.keyframes);
   EXPECT_EQ(after.voxels, before.voxels);
   EXPECT_THROW(Mapper{Intrinsics()}, Error);
+}
+
+/// The map objects of `map` that lie within `tolerance` of a same-category object of `other`
+/// moved by `G` (x -> G x), with semi-axes within `tolerance` of its.
+int objectsMatched(const ObjectMap& map, const ObjectMap& other, const Pose& G, double tolerance) {
+  int n = 0;
+  for (const MapObject& a : map.objects)
+    for (const MapObject& b : other.objects)
+      if (a.category == b.category && (a.ellipsoid.center() - G.transform(b.ellipsoid.center())).norm() < tolerance) {
+        Eigen::Vector3d sa = a.ellipsoid.axes(), sb = b.ellipsoid.axes();
+        std::sort(sa.data(), sa.data() + 3);
+        std::sort(sb.data(), sb.data() + 3);
+        n += (sa - sb).cwiseAbs().maxCoeff() < tolerance;
+        break;
+      }
+  return n;
+}
+
+// A host whose world origin is elsewhere (every keyframe pose moved by one shift G: the same
+// frames, so the same tracks; a box fit starts with the world's axes, so a rotation would start
+// it elsewhere) builds the same boxes map in its frame; given the poses in this frame, its
+// objects are fitted again and are this frame's map to the last digits (each fit starts from
+// the boxes alone).
+TEST(Mapper, BoxMapsAreFittedAgainAtTheHostsNewKeyframePoses) {
+  const test::SimSequence seq = boxSequence();
+  const Pose G(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.4, -0.2, 0.1));
+  Mapper here(seq.K, boxesMode()), there(seq.K, boxesMode());
+  std::vector<Pose> poses;
+  for (const auto& kf : seq.keyframes) {
+    here.addKeyframe(kf.pose, kf.detections);
+    there.addKeyframe(kf.pose * G, kf.detections);
+    poses.push_back(kf.pose);
+  }
+  here.finish();
+  there.finish();
+  const ObjectMap expected = here.map(), before = there.map();
+  ASSERT_GE(expected.objects.size(), 3u);
+  ASSERT_EQ(before.objects.size(), expected.objects.size());
+  EXPECT_EQ(objectsMatched(expected, before, G, 1e-6), static_cast<int>(expected.objects.size()));
+  EXPECT_EQ(objectsMatched(expected, before, Pose(), 0.1), 0);
+
+  there.updateKeyframePoses(poses);
+  const ObjectMap after = there.map();
+  ASSERT_EQ(after.objects.size(), expected.objects.size());
+  for (size_t i = 0; i < after.objects.size(); ++i) {
+    const MapObject &a = after.objects[i], &e = expected.objects[i];
+    EXPECT_EQ(a.id, e.id);
+    EXPECT_EQ(a.category, e.category);
+    EXPECT_LT((a.ellipsoid.center() - e.ellipsoid.center()).norm(), 1e-9) << a.id;
+    EXPECT_LT((a.ellipsoid.axes() - e.ellipsoid.axes()).norm(), 1e-9) << a.id;
+  }
+  ASSERT_TRUE(after.camera_envelope && expected.camera_envelope);
+  EXPECT_NEAR(after.camera_envelope->min_height, expected.camera_envelope->min_height, 1e-9);
+  EXPECT_NEAR(after.camera_envelope->max_height, expected.camera_envelope->max_height, 1e-9);
+}
+
+// A trajectory that drifts (each keyframe's pose off by a rotation and a shift growing to 6
+// degrees and 30 cm) places the objects where no keyframe agrees; once the host corrects the
+// poses (a loop closure), the objects are fitted to their boxes at the corrected poses.
+TEST(Mapper, ABoxMapFollowsALoopClosure) {
+  const test::SimSequence seq = boxSequence();
+  Mapper mapper(seq.K, boxesMode()), truth(seq.K, boxesMode());
+  std::vector<Pose> poses;
+  const double n = static_cast<double>(seq.keyframes.size());
+  for (size_t i = 0; i < seq.keyframes.size(); ++i) {
+    const auto& kf = seq.keyframes[i];
+    const Pose drift(Eigen::AngleAxisd(0.1 * i / n, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                     Eigen::Vector3d(0.3 * i / n, 0.0, 0.0));
+    mapper.addKeyframe(kf.pose * drift, kf.detections);
+    truth.addKeyframe(kf.pose, kf.detections);
+    poses.push_back(kf.pose);
+  }
+  mapper.finish();
+  truth.finish();
+  const ObjectMap expected = truth.map();
+  const int drifted = objectsMatched(expected, mapper.map(), Pose(), 0.02);
+  mapper.updateKeyframePoses(poses);
+  const int corrected = objectsMatched(expected, mapper.map(), Pose(), 0.02);
+  EXPECT_GE(corrected, static_cast<int>(expected.objects.size()) - 1);
+  EXPECT_LE(drifted, corrected / 2);
+}
+
+// Voxel mode keeps no depth image: each object moves with the keyframe that saw it last. With
+// every pose moved by one rigid transform, that brings each object where the map made in this
+// frame has it (to a voxel: the grids differ), and the up measured on the floor with it.
+TEST(Mapper, VoxelObjectsMoveWithTheKeyframeThatSawThemLast) {
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 3, 12, test::mappingNoise());
+  const Pose G(Eigen::AngleAxisd(0.1, Eigen::Vector3d(1, 2, 0).normalized()).toRotationMatrix(),
+               Eigen::Vector3d(0.3, 0.2, -0.1));
+  MapperOptions opt;
+  opt.estimate_up_from_floor = true;
+  Mapper here(seq.K, opt), there(seq.K, opt);
+  std::vector<Pose> poses;
+  for (const auto& kf : seq.keyframes) {
+    here.addKeyframe(kf.pose, kf.detections, &kf.depth);
+    there.addKeyframe(kf.pose * G, kf.detections, &kf.depth);
+    poses.push_back(kf.pose);
+  }
+  const ObjectMap expected = here.map();
+  ASSERT_GE(expected.objects.size(), 3u);
+  EXPECT_EQ(objectsMatched(expected, there.map(), Pose(), 0.05), 0);
+  there.updateKeyframePoses(poses);
+  EXPECT_EQ(objectsMatched(expected, there.map(), Pose(), 0.01), static_cast<int>(expected.objects.size()));
+  EXPECT_LT((there.stats().up - here.stats().up).norm(), 1e-6);
+  EXPECT_LT((there.stats().up - Eigen::Vector3d::UnitZ()).norm(), 0.02);
+}
+
+TEST(Mapper, KeyframePosesOfAnotherCountOrNotFiniteAreRefused) {
+  const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 1, 3, sim::NoiseModel());
+  Mapper mapper(seq.K);
+  std::vector<Pose> poses;
+  for (const auto& kf : seq.keyframes) {
+    mapper.addKeyframe(kf.pose, kf.detections, &kf.depth);
+    poses.push_back(kf.pose);
+  }
+  const ObjectMap before = mapper.map();
+  const auto refused = [&](const std::vector<Pose>& given, const std::string& why) {
+    try {
+      mapper.updateKeyframePoses(given);
+      ADD_FAILURE() << "accepted: " << why;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  };
+  refused({poses.begin(), poses.end() - 1}, "2 keyframe pose(s) given for 3 keyframe(s) added");
+  std::vector<Pose> bad = poses;
+  bad[1] = Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, std::nan(""), 0));
+  refused(bad, "keyframe 1: pose is not a finite rigid transform");
+  const ObjectMap after = mapper.map();
+  ASSERT_EQ(after.objects.size(), before.objects.size());
+  for (size_t i = 0; i < after.objects.size(); ++i)
+    EXPECT_EQ(after.objects[i].ellipsoid.center(), before.objects[i].ellipsoid.center());
 }
 
 TEST(Mapper, OptionsOutOfRangeAreRefusedNamingTheField) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -126,6 +127,62 @@ TEST(VoxelObject, PointMeansLieOnTheSurface) {
     z.push_back(m.z());
   }
   EXPECT_NEAR(median(z), 2.0031 + 0.75 * 0.004, 2e-4);
+}
+
+// Moved rigidly, a plane seen by one camera is the plane that camera sees once moved with it:
+// every point mean moves exactly (to the storage's 1/65536 of a voxel) and stays in its voxel,
+// the probabilities go with them, and two means that land in one voxel become one.
+TEST(VoxelObject, MovedRigidlyTheVoxelsFollowTheirPoints) {
+  VoxelObject v;
+  const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
+  const BinaryMask mask = rectMask(250, 200, 390, 300);
+  v.integrate(kVoxelCamera, camera, flatDepth(2.5f), mask);
+  v.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 320, 300));  // the left part twice
+  const std::vector<Eigen::Vector3d> before = v.occupiedPointMeans(0.01);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Vector3d t(1.234, -0.5, 3.0);
+  VoxelObject moved = v;
+  moved.moveRigidly(R, t);
+  const Pose moved_camera = camera * Pose(R, t).inverse();  // sees the moved plane as `camera` saw it
+  const std::vector<Eigen::Vector3d> after = moved.occupiedPointMeans(0.01), centres = moved.occupiedCentres(0.01);
+  ASSERT_EQ(after.size(), centres.size());
+  EXPECT_LE(after.size(), before.size());
+  EXPECT_GT(after.size(), before.size() * 8 / 10);  // a rotated grid merges a few neighbours
+  const double voxel = v.options().voxel_size;
+  for (size_t i = 0; i < after.size(); ++i) {
+    EXPECT_NEAR(moved_camera.transform(after[i]).z(), 2.5, 1e-5);
+    EXPECT_LE((after[i] - centres[i]).cwiseAbs().maxCoeff(), 0.5 * voxel + 1e-9);
+  }
+  // Each moved mean is a mean of moved points: the nearest moved point lies within a voxel.
+  for (const Eigen::Vector3d& a : after) {
+    double nearest = 1e9;
+    for (const Eigen::Vector3d& b : before) nearest = std::min(nearest, (R * b + t - a).norm());
+    EXPECT_LT(nearest, voxel);
+  }
+  // The evidence goes with the points: the left part, hit twice, and the right part, hit once
+  // and then missed (outside the second mask).
+  const auto meanNear = [&](double u, double v_px) {
+    const Eigen::Vector3d x_c((u - kVoxelCamera.cx) / kVoxelCamera.fx * 2.5,
+                              (v_px - kVoxelCamera.cy) / kVoxelCamera.fy * 2.5, 2.5);
+    const Eigen::Vector3d x = camera.inverse().transform(x_c);
+    return *std::min_element(before.begin(), before.end(), [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      return (a - x).norm() < (b - x).norm();
+    });
+  };
+  const Eigen::Vector3d left = meanNear(260, 250), right = meanNear(380, 250);
+  EXPECT_NEAR(v.probabilityAt(left), bayes(0.7, 0.7), 1e-6);
+  EXPECT_NEAR(v.probabilityAt(right), bayes(0.7, 0.3), 1e-6);
+  EXPECT_NEAR(moved.probabilityAt(R * left + t), bayes(0.7, 0.7), 1e-6);
+  EXPECT_NEAR(moved.probabilityAt(R * right + t), bayes(0.7, 0.3), 1e-6);
+  // Moved back, the means are where they were.
+  moved.moveRigidly(R.transpose(), -R.transpose() * t);
+  const std::vector<Eigen::Vector3d> back = moved.occupiedPointMeans(0.01);
+  ASSERT_FALSE(back.empty());
+  for (const Eigen::Vector3d& a : back) {
+    double nearest = 1e9;
+    for (const Eigen::Vector3d& b : before) nearest = std::min(nearest, (b - a).norm());
+    EXPECT_LT(nearest, voxel);
+  }
 }
 
 TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {

@@ -18,6 +18,7 @@
 #include <optional>
 #include <shared_mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ellreloc/core/camera.hpp"
@@ -120,6 +121,17 @@ class Mapper {
   /// nothing.
   void finish();
 
+  /// The host moved its keyframes (a bundle adjustment, a loop closure): `poses` holds the
+  /// world->camera pose of every keyframe added so far, in the order they were added. Boxes
+  /// mode: every object is fitted again to its boxes, each seen from its keyframe's new pose (as
+  /// finish() does, so the map is what these poses would have made of the same associations).
+  /// Voxel mode: the depth images are gone, so each object moves rigidly with the keyframe that
+  /// saw it last (its voxels go where that keyframe's camera now puts them); the up estimated
+  /// from the floor is measured again from each keyframe's floor at its new pose. The camera
+  /// envelope follows the new poses. Throws ellreloc::Error naming the problem (the map then
+  /// unchanged) when the count differs from the keyframes added or a pose is not finite.
+  void updateKeyframePoses(const std::vector<Pose>& poses);
+
   /// The objects in the map (those with an ellipsoid), in the order they were created, and
   /// the camera envelope of the keyframes (heights and tilts along the world's up in voxel
   /// mode or with boxes.up, else along their mean image-up; widened by 1 m and 30 degrees;
@@ -135,6 +147,7 @@ class Mapper {
     int id = 0;
     VoxelObject voxels;
     std::vector<BoxView> views;       // boxes mode
+    std::vector<int> view_keyframes;  // boxes mode: the keyframe of each view
     std::vector<int> keyframes_seen;  // boxes mode: the keyframes that detected it, ascending
     std::map<int, double> labels;
     int observations = 0;
@@ -172,6 +185,9 @@ class Mapper {
   std::vector<Pose> keyframe_poses_;  // for the map's camera envelope
   int next_id_ = 0;
   Eigen::Vector3d floor_normal_sum_ = Eigen::Vector3d::Zero();
+  // Each keyframe's floor normal (times its inlier share) in its camera's frame, for
+  // updateKeyframePoses.
+  std::vector<std::pair<int, Eigen::Vector3d>> floor_in_camera_;
   std::vector<int> raw_pixel_;  // voxel mode through a lens: each pinhole pixel's raw pixel
 };
 

@@ -78,6 +78,12 @@ class VoxelObject {
   /// they are not counted.
   void absorb(const VoxelObject& other);
 
+  /// Moves the object rigidly, x -> R x + t (a host's correction of the keyframes that saw it):
+  /// each voxel's mean depth point is moved and falls into the voxel of the grid that holds it
+  /// now; where two land in one voxel, it keeps the stronger evidence and their points' mean.
+  /// Voxels moved beyond the grid's range (about 10 km from the origin at 1 cm) are dropped.
+  void moveRigidly(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+
   /// Number of voxels held (any probability).
   size_t size() const { return voxels_.size(); }
   /// Number of voxels at or above options().occupied_probability.
