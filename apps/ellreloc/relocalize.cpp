@@ -633,9 +633,16 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     writeOverlays(a, object_map, K, frames, observations, results, references,
                   observe_options.lens ? &*observe_options.lens : nullptr);
   if (!a.report.empty()) io::writeFileAtomically(a.report, report.dump(1) + "\n");
-  if (!console.quiet)
+  if (!console.quiet) {
     std::printf("wrote %s: %zu of %zu frames relocalized (%s), median %.1f ms per frame\n", a.out.c_str(), poses.size(),
                 frames.size(), a.method.c_str(), median(times));
+    const auto withheld = std::count_if(results.begin(), results.end(), [](const RelocalizationResult& r) {
+      return r.status == RelocalizationStatus::LowEvidence;
+    });
+    if (withheld > 0)
+      std::printf("%ld more pose(s) found but withheld as weakly supported (in --report; --accept-all writes them)\n",
+                  static_cast<long>(withheld));
+  }
   if (without_region > 0 && !console.quiet)
     std::printf("%zu frame(s) before the first pose of %s: searched everywhere\n", without_region, a.near.c_str());
   if (!a.track.empty() && !console.quiet) printTrackSummary(a, tracks, without_odometry);

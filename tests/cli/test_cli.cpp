@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -178,6 +179,28 @@ TEST(Cli, Fr2DeskKeyframesStayAboveTheMeasuredFloor) {
   EXPECT_GE(f.valid_percent, 60.0);
   EXPECT_LE(f.median_cm, 15.0);
   EXPECT_LE(f.wrong, 16.0);  // measured 14 (docs/benchmarks.md, "Real data")
+}
+
+// The summary says how many poses were found but withheld (the report's "low evidence"
+// frames), and that --accept-all writes them: measured 29 of fr2's keyframes.
+TEST(Cli, Fr2DeskKeyframesSayHowManyPosesWereWithheld) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr2_desk");
+  const std::string common = "relocalize --camera " + d + "/camera.yaml --map " + d + "/map.json --detections " + d +
+                             "/keyframes.detections.json --threads 2 --out " + dir.path("poses.txt");
+  const CliRun r = run(common + " --report " + dir.path("report.json"), dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir.path("report.json"));
+  const nlohmann::json report = nlohmann::json::parse(in);
+  const auto withheld = std::count_if(report.begin(), report.end(),
+                                      [](const nlohmann::json& f) { return f.at("status") == "low evidence"; });
+  EXPECT_GT(withheld, 20);
+  EXPECT_NE(r.out.find(std::to_string(withheld) + " more pose(s) found but withheld as weakly supported"),
+            std::string::npos)
+      << r.out;
+  const CliRun all = run(common + " --accept-all", dir);
+  ASSERT_EQ(all.code, 0) << all.err;
+  EXPECT_EQ(all.out.find("withheld"), std::string::npos) << all.out;
 }
 
 // Wrong poses on real data are ambiguous ones: asking for a margin over the best rival drops
