@@ -280,7 +280,7 @@ class Mapper:
     def __init__(self, camera: Intrinsics, options: Optional[MapperOptions] = ..., mode: str | MappingMode | None = ...) -> None: ...
     def add_keyframe(self, pose: Pose, detections: Sequence[Detection], depth: ArrayLike | None = ..., depth_scale: float = ...) -> KeyframeReport: """Adds a keyframe: world->camera pose, detections, and (voxel mode) the depth image, (height, width) uint16 in depth_scale units per metre (TUM: 5000) or float metres. On error the map is unchanged."""
     def finish(self) -> None: """Boxes mode: refits every object whose views grew. Call after the last keyframe."""
-    def update_keyframe_poses(self, poses: Sequence[Pose]) -> None: """The host moved its keyframes (bundle adjustment, loop closure): the world->camera pose of every keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves each object with the keyframe that saw it last. On error the map is unchanged."""
+    def update_keyframe_poses(self, poses: Sequence[Pose]) -> None: """The host moved its keyframes (bundle adjustment, loop closure): the world->camera pose of every keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves each object with the keyframe that saw it last; objects that now coincide are joined. On error the map is unchanged."""
     def map(self) -> ObjectMap: """The current object map."""
     stats: MapperStats
     camera: Intrinsics

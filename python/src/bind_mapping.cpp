@@ -150,7 +150,8 @@ void bindMapperClass(py::module_& m) {
            py::arg("poses"),
            "The host moved its keyframes (bundle adjustment, loop closure): the world->camera pose of every "
            "keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves "
-           "each object with the keyframe that saw it last. On error the map is unchanged.")
+           "each object with the keyframe that saw it last; objects that now coincide are joined. On error the map "
+           "is unchanged.")
       .def("map", &Mapper::map, py::call_guard<py::gil_scoped_release>(), "The current object map.")
       .def_property_readonly("stats", &Mapper::stats)
       .def_property_readonly("camera", &Mapper::intrinsics)

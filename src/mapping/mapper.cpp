@@ -307,6 +307,10 @@ void Mapper::updateKeyframePoses(const std::vector<Pose>& poses) {
     if (t.confirmed) rebuild(t);
   }
   keyframe_poses_ = poses;
+  if (options_.mode == MappingMode::Boxes)
+    mergeDuplicateBoxTracks();
+  else
+    mergeDuplicateVoxelTracks(/*every_pair=*/true);
 }
 
 void Mapper::rebuild(Track& track) const {
@@ -423,18 +427,18 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
   mergeDuplicateVoxelTracks();
 }
 
-void Mapper::mergeDuplicateVoxelTracks() {
+void Mapper::mergeDuplicateVoxelTracks(bool every_pair) {
   // A detection that neither 2D tracking nor 3D matching associates starts a new object: a
   // second detection of an object another detection already updated in this keyframe, or an
   // object first seen from a side whose surface has too few voxels near the known ones. Once
   // the new model's surface overlaps the old one, the paper's 3D matching test (eq. 4)
   // recognises them; two objects of one label that pass it are one object, and the younger
-  // joins the older. Only pairs with an object updated in this keyframe can have changed, so
-  // only those are tested.
+  // joins the older. While mapping, only pairs with an object updated in this keyframe can have
+  // changed, so only those are tested.
   for (size_t i = 0; i < tracks_.size(); ++i) {
     for (size_t j = i + 1; j < tracks_.size(); ++j) {
       Track &a = tracks_[i], &b = tracks_[j];
-      if (a.last_seen != keyframes_ && b.last_seen != keyframes_) continue;
+      if (!every_pair && a.last_seen != keyframes_ && b.last_seen != keyframes_) continue;
       if (a.label() != b.label()) continue;
       // Centres within the smaller object's mean half-extent, as in mergeDuplicateBoxTracks: an
       // object that wrongly grew over a neighbour of its label must not swallow it whole.

@@ -618,6 +618,64 @@ TEST(Mapper, VoxelObjectsMoveWithTheKeyframeThatSawThemLast) {
   EXPECT_LT((there.stats().up - Eigen::Vector3d::UnitZ()).norm(), 0.02);
 }
 
+// A loop: the camera maps a book from an arc (keyframes 0-7), looks away (8-11), and comes back
+// along the arc with its poses drifted by 40 cm, so the book's boxes fall where the map holds
+// nothing and a second book is made there. Once the host closes the loop (the true poses), both
+// are fitted where the book is, and joined: one book, with every detection.
+TEST(Mapper, ALoopClosureJoinsTheTwoObjectsADriftMadeOfOne) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const int kBook = 73;
+  const Ellipsoid book(Eigen::Vector3d(0, 0, 0.02), Eigen::Vector3d(0.12, 0.09, 0.02), Eigen::Matrix3d::Identity());
+  const Pose drift(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.4, 0.0, 0.0));
+  Mapper mapper(K, boxesMode());
+  std::vector<Pose> poses;
+  for (int i = 0; i < 20; ++i) {
+    const bool away = i >= 8 && i < 12;
+    const Pose pose =
+        away ? Pose::lookAt(Eigen::Vector3d(1.5, 0, 0.8), Eigen::Vector3d(3, 0, 0.8)) : arcPose(i < 8 ? i : 19 - i);
+    std::vector<Detection> boxes;
+    if (!away) boxes.push_back(boxOf(book, kBook, K, pose));
+    mapper.addKeyframe(i < 12 ? pose : pose * drift, boxes);
+    poses.push_back(pose);
+  }
+  mapper.finish();
+  ASSERT_EQ(mapper.map().objects.size(), 2u);
+  mapper.updateKeyframePoses(poses);
+  const ObjectMap map = mapper.map();
+  ASSERT_EQ(map.objects.size(), 1u);
+  EXPECT_LT((map.objects[0].ellipsoid.center() - book.center()).norm(), 0.02);
+  EXPECT_EQ(mapper.objects()[0].observations, 16);
+}
+
+// The same loop in voxel mode (a box on the floor, the return drifted by a metre): the two models
+// of the box, moved with their keyframes, share their surface again and are joined.
+TEST(Mapper, ALoopClosureJoinsTwoVoxelModelsOfOneObject) {
+  const sim::Scene scene = oneBoxScene();
+  const sim::SimObject& box = scene.objects[0];
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const Pose drift(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1.0, 0.0, 0.0));
+  Mapper mapper(K);
+  std::mt19937_64 rng(1);
+  std::vector<Pose> poses;
+  for (int i = 0; i < 16; ++i) {
+    const bool away = i >= 6 && i < 10;
+    const double a = -0.3 + 0.1 * (i < 6 ? i : 15 - i);  // out along an arc around the box, and back
+    const Eigen::Vector3d eye(2.0 * std::cos(a), 2.0 * std::sin(a), 1.2);
+    const Pose pose = Pose::lookAt(eye, away ? Eigen::Vector3d(2 * eye.x(), 2 * eye.y(), 1.2) : box.box_center);
+    const sim::RenderedFrame frame = sim::render(scene, K, pose);
+    const auto detections = sim::detect(scene, frame, sim::NoiseModel(), rng);
+    const DepthImage depth = sim::noisyDepth(frame, sim::NoiseModel(), rng);
+    mapper.addKeyframe(i < 10 ? pose : pose * drift, detections, &depth);
+    poses.push_back(pose);
+  }
+  ASSERT_EQ(mapper.map().objects.size(), 2u);
+  mapper.updateKeyframePoses(poses);
+  const ObjectMap map = mapper.map();
+  ASSERT_EQ(map.objects.size(), 1u);
+  EXPECT_LT((map.objects[0].ellipsoid.center() - box.box_center).norm(), 0.03);
+  EXPECT_EQ(mapper.objects()[0].observations, 12);
+}
+
 TEST(Mapper, KeyframePosesOfAnotherCountOrNotFiniteAreRefused) {
   const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 1, 3, sim::NoiseModel());
   Mapper mapper(seq.K);

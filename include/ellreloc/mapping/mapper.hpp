@@ -127,9 +127,11 @@ class Mapper {
   /// finish() does, so the map is what these poses would have made of the same associations).
   /// Voxel mode: the depth images are gone, so each object moves rigidly with the keyframe that
   /// saw it last (its voxels go where that keyframe's camera now puts them); the up estimated
-  /// from the floor is measured again from each keyframe's floor at its new pose. The camera
-  /// envelope follows the new poses. Throws ellreloc::Error naming the problem (the map then
-  /// unchanged) when the count differs from the keyframes added or a pose is not finite.
+  /// from the floor is measured again from each keyframe's floor at its new pose. Objects that
+  /// now coincide are joined as while mapping (two tracks of one object that a drift split before
+  /// a loop closed). The camera envelope follows the new poses. Throws ellreloc::Error naming the
+  /// problem (the map then unchanged) when the count differs from the keyframes added or a pose
+  /// is not finite.
   void updateKeyframePoses(const std::vector<Pose>& poses);
 
   /// The objects in the map (those with an ellipsoid), in the order they were created, and
@@ -172,7 +174,9 @@ class Mapper {
                       KeyframeReport* report);
   void observed(Track& track, const Detection& detection);
   void mergeDuplicateBoxTracks();
-  void mergeDuplicateVoxelTracks();
+  /// Pairs with an object updated in this keyframe (the others cannot have changed), or every
+  /// pair once the keyframes moved.
+  void mergeDuplicateVoxelTracks(bool every_pair = false);
   void rebuild(Track& track) const;
   /// The world's up: the floor's normal when estimated, else the options' (mutex_ held).
   Eigen::Vector3d upLocked() const;
