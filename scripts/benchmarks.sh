@@ -73,8 +73,9 @@ if [ -d "$build/python/ellreloc" ] && [ -n "$python" ]; then
   table regular_verdict env PYTHONPATH="$build/python" "$python" benchmarks/regular_verdict.py \
     "$data/independent_synth/office_s11" "$out/scenes/sim_office_1" "$out/scenes/sim_office_2"
   table split_map_limits env PYTHONPATH="$build/python" "$python" scripts/split_map_limits.py "$build" "$data"
+  table unit_estimates env PYTHONPATH="$build/python" "$python" scripts/unit_estimates.py "$data"
 else
-  echo "benchmarks: python_overhead, regular_verdict and split_map_limits skipped (no Python bindings in $build)" >&2
+  echo "benchmarks: python_overhead, regular_verdict, split_map_limits and unit_estimates skipped (no Python bindings in $build)" >&2
 fi
 table startup python3 benchmarks/startup.py "$build" "$data" "$python"
 

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 
 #include "commands.hpp"
 #include "ellreloc/core/coco.hpp"
@@ -63,7 +64,7 @@ void printQuality(const MapQuality& q) {
 
 /// Objects per category, what was left out, and the candidates that never entered the map.
 void printSummary(const ObjectMap& map, const std::vector<std::string>& dropped, const MapperStats& stats,
-                  int min_observations) {
+                  int min_observations, double unit_metres, std::optional<double> unit_told) {
   std::map<int, int> per_category;
   for (const MapObject& o : map.objects) ++per_category[o.category];
   std::string line;
@@ -84,7 +85,13 @@ void printSummary(const ObjectMap& map, const std::vector<std::string>& dropped,
     std::printf(
         "  camera envelope (relocalization keeps to it): heights %.2f to %.2f m along up (%.3f, %.3f, %.3f), "
         "tilts %.0f to %.0f deg\n",
-        e->min_height, e->max_height, e->up(0), e->up(1), e->up(2), e->min_tilt_deg, e->max_tilt_deg);
+        e->min_height * unit_metres, e->max_height * unit_metres, e->up(0), e->up(1), e->up(2), e->min_tilt_deg,
+        e->max_tilt_deg);
+  if (unit_told)
+    std::printf(
+        "  the objects' sizes tell %.3g m per unit of the trajectory (taken: %.3g; for poses of unknown scale, "
+        "map again with --unit-metres %.3g)\n",
+        *unit_told, unit_metres, *unit_told);
 }
 
 }  // namespace
@@ -110,6 +117,11 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
   m->add_flag("--undistort", a.undistort,
               "the detections (and depth images) are raw images of a distorted lens: undistort them with the "
               "--camera file's Camera.k1, k2, p1, p2, k3 (left out: 0)");
+  m->add_option("--unit-metres", a.unit_metres,
+                "boxes mode: the length of the trajectory's unit in metres, for a monocular SLAM system's poses "
+                "(the summary gives the unit the objects' sizes tell)")
+      ->check(CLI::Range(1e-6, 1e6))
+      ->capture_default_str();
   m->add_option("--holdout-every", a.holdout_every,
                 "leave every N-th frame out of the map and report how well the map explains its boxes")
       ->check(CLI::Range(2, 1000000));
@@ -134,6 +146,9 @@ void map(const MapArgs& a, const Console& console) {
   if (a.undistort) options.lens = io::readLens(a.camera);
   const Intrinsics K = options.lens ? options.lens->intrinsics : io::readCamera(a.camera);
   if (!parseMappingMode(a.mode, &options.mode)) throw Error("--mode: unknown mode '" + a.mode + "' (voxel, boxes)");
+  if (options.mode == MappingMode::Voxel && a.unit_metres != 1.0)
+    throw Error("--unit-metres: boxes mode only (voxel mode's depth images are in metres)");
+  options.unit_metres = a.unit_metres;
   if (!a.up.empty()) {
     const Eigen::Vector3d up(a.up[0], a.up[1], a.up[2]);
     if (!up.allFinite() || !(up.norm() > 1e-9)) throw Error("--up: not a direction (finite, non-zero)");
@@ -211,7 +226,8 @@ void map(const MapArgs& a, const Console& console) {
     std::printf("wrote %s: %s from %s (%s mode; %s without pose%s)\n", a.out.c_str(),
                 counted(result.objects.size(), "object").c_str(), counted(used, "keyframe").c_str(), a.mode.c_str(),
                 counted(no_pose, "frame").c_str(), no_depth_text.c_str());
-    printSummary(result, dropped, mapper.stats(), options.min_observations);
+    printSummary(result, dropped, mapper.stats(), options.min_observations, a.unit_metres,
+                 mapper.estimatedUnitMetres());
   }
   if (!a.holdout.empty() || a.holdout_every > 0) printQuality(measureMapQuality(result, K, held_out));
 }

@@ -281,6 +281,7 @@ class Mapper:
     def add_keyframe(self, pose: Pose, detections: Sequence[Detection], depth: ArrayLike | None = ..., depth_scale: float = ...) -> KeyframeReport: """Adds a keyframe: world->camera pose, detections, and (voxel mode) the depth image, (height, width) uint16 in depth_scale units per metre (TUM: 5000) or float metres. On error the map is unchanged."""
     def finish(self) -> None: """Boxes mode: refits every object whose views grew. Call after the last keyframe."""
     def update_keyframe_poses(self, poses: Sequence[Pose]) -> None: """The host moved its keyframes (bundle adjustment, loop closure): the world->camera pose of every keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves each object with the keyframe that saw it last; objects that now coincide are joined. On error the map is unchanged."""
+    def estimated_unit_metres(self, min_objects: int = ...) -> Optional[float]: """Boxes mode: the poses' unit in metres that the triangulated objects' sizes tell (None with fewer than min_objects of them): map again with it as MapperOptions.unit_metres until it settles."""
     def map(self) -> ObjectMap: """The current object map."""
     stats: MapperStats
     camera: Intrinsics
@@ -302,6 +303,7 @@ class MapperOptions:
     min_score: float
     estimate_up_from_floor: bool
     min_mask_pixels: int
+    unit_metres: float
     lens: Optional[Lens]
     def validate(self) -> str: ...
 

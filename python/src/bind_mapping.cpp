@@ -97,6 +97,8 @@ void bindMapperOptions(py::module_& m) {
       .def_readwrite("min_score", &MapperOptions::min_score)
       .def_readwrite("estimate_up_from_floor", &MapperOptions::estimate_up_from_floor)
       .def_readwrite("min_mask_pixels", &MapperOptions::min_mask_pixels)
+      .def_readwrite("unit_metres", &MapperOptions::unit_metres,
+                     "boxes mode: the length of the keyframe poses' unit in metres (a monocular SLAM map's own)")
       .def_readwrite("lens", &MapperOptions::lens,
                      "the Lens of the keyframes' raw images: boxes undistorted, masks and depth images resampled")
       .def("validate", &MapperOptions::validate);
@@ -152,6 +154,9 @@ void bindMapperClass(py::module_& m) {
            "keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves "
            "each object with the keyframe that saw it last; objects that now coincide are joined. On error the map "
            "is unchanged.")
+      .def("estimated_unit_metres", &Mapper::estimatedUnitMetres, py::arg("min_objects") = 5,
+           "Boxes mode: the poses' unit in metres that the triangulated objects' sizes tell (None with fewer than "
+           "min_objects of them): map again with it as MapperOptions.unit_metres until it settles.")
       .def("map", &Mapper::map, py::call_guard<py::gil_scoped_release>(), "The current object map.")
       .def_property_readonly("stats", &Mapper::stats)
       .def_property_readonly("camera", &Mapper::intrinsics)

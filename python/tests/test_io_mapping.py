@@ -222,6 +222,32 @@ def test_a_box_map_is_fitted_again_at_the_keyframes_new_poses(data_dir, tmp_path
     assert (tmp_path / "there.json").read_bytes() == (tmp_path / "here.json").read_bytes()
 
 
+def test_the_objects_tell_a_monocular_map_its_unit(data_dir):
+    """fr3's boxes with the poses in a unit of 2.5 m, as a monocular SLAM system's might be: the
+    objects' sizes tell the unit (measured 2.27 m, then 2.27 mapped again with it; 0.91 for
+    metric poses: the categories' typical sizes are about a tenth larger than fr3's objects)."""
+    d = data_dir / "tum_fr3_office_first_half"
+    camera, truth = E.read_camera(d / "camera.yaml"), E.read_trajectory(d / "groundtruth.txt")
+    index = E.time_index(truth)
+    keyframes = [(truth[k].pose, f.detections) for f in E.read_detections(d / "detections.json")[:800:2]
+                 if (k := index.nearest(f.timestamp)) is not None]
+
+    def estimate(unit_of_poses, unit_metres):
+        options = E.MapperOptions()
+        options.unit_metres = unit_metres
+        mapper = E.Mapper(camera, options, mode="boxes")
+        for pose, detections in keyframes:
+            mapper.add_keyframe(E.Pose(pose.R_cw, pose.t_cw / unit_of_poses), detections)
+        mapper.finish()
+        return mapper.estimated_unit_metres()
+
+    first = estimate(2.5, 1.0)
+    assert first == pytest.approx(2.5, rel=0.15)
+    assert estimate(2.5, first) == pytest.approx(2.5, rel=0.15)
+    assert estimate(1.0, 1.0) == pytest.approx(1.0, rel=0.15)
+    assert E.Mapper(camera, mode="boxes").estimated_unit_metres() is None  # no object yet
+
+
 def test_a_mapped_map_keeps_the_relocalizer_where_it_was_made(data_dir, tmp_path):
     d = data_dir / "tum_fr3_office_first_half"
     camera, truth = E.read_camera(d / "camera.yaml"), E.read_trajectory(d / "groundtruth.txt")

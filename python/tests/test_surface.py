@@ -95,6 +95,7 @@ def test_every_relocalizer_and_mapper_option_reaches_the_library(fr2, office):
     for path, value in fields:
         assert same(lookup(copied, path), changed(value)), path
     mapper_options = E.MapperOptions()
+    mapper_options.mode = E.MappingMode.boxes  # a unit_metres other than 1 is for boxes mode
     mapper_fields = [(p, v) for p, v in leaves(mapper_options) if p not in ("mode", "lens")]
     for path, value in mapper_fields:
         assign(mapper_options, path, changed(value))

@@ -179,6 +179,7 @@ std::string MapperOptions::validate() const {
       {"floor.pixel_stride", double(floor.pixel_stride), 1, 1e6},
       {"floor.iterations", double(floor.iterations), 1, inf},
       {"min_mask_pixels", double(min_mask_pixels), 0, inf},
+      {"unit_metres", unit_metres, 1e-6, 1e6},
   };
   for (const Range& r : ranges)
     if (!(r.value >= r.lo && r.value <= r.hi))  // NaN fails too
@@ -190,6 +191,8 @@ std::string MapperOptions::validate() const {
   if (boxes.up && !unit(*boxes.up)) return "boxes.up is zero or not finite";
   if (lens)
     if (const std::string why = lens->whyNotUsable(); !why.empty()) return "lens: " + why;
+  if (mode == MappingMode::Voxel && unit_metres != 1.0)
+    return "unit_metres must be 1 in voxel mode: depth is in metres";
   return "";
 }
 
@@ -313,6 +316,39 @@ void Mapper::updateKeyframePoses(const std::vector<Pose>& poses) {
     mergeDuplicateVoxelTracks(/*every_pair=*/true);
 }
 
+BoxSizePrior Mapper::sizePrior(int category) const {
+  BoxSizePrior prior;
+  const double unit = options_.unit_metres;
+  prior.typical_semi_axes = typicalSemiAxes(category) / unit;
+  prior.min_axis /= unit;
+  prior.max_axis /= unit;
+  return prior;
+}
+
+std::optional<double> Mapper::estimatedUnitMetres(int min_objects) const {
+  std::shared_lock lock(mutex_);
+  if (options_.mode != MappingMode::Boxes) return std::nullopt;
+  std::vector<double> units;
+  for (const Track& t : tracks_) {
+    if (!t.confirmed || !t.built || t.built->depth_from_size) continue;
+    // The rays alone place the object (the size prior, in the unit assumed, does not), and each
+    // box's half-size at that depth is its size in the world's unit: half its two larger axes
+    // in metres, for a typical object of its category seen on its broad side.
+    const std::optional<Eigen::Vector3d> centre = triangulateBoxCentres(K_, t.views);
+    if (!centre) continue;
+    std::vector<double> radii;
+    for (const BoxView& v : t.views) {
+      const double z = v.pose.transform(*centre).z();
+      if (z > 0.0) radii.push_back(0.25 * (v.box.width() / K_.fx + v.box.height() / K_.fy) * z);
+    }
+    const double radius = median(radii);
+    const Eigen::Vector3d typical = typicalSemiAxes(t.built->object.category);  // smallest first
+    if (radius > 0.0) units.push_back(0.5 * (typical(1) + typical(2)) / radius);
+  }
+  if (static_cast<int>(units.size()) < std::max(1, min_objects)) return std::nullopt;
+  return median(units);
+}
+
 void Mapper::rebuild(Track& track) const {
   MappedObject m;
   m.object.id = track.id;
@@ -329,9 +365,7 @@ void Mapper::rebuild(Track& track) const {
     m.voxels = track.voxels.size();
     m.memory_bytes = track.voxels.memoryBytes();
   } else {
-    BoxSizePrior prior;
-    prior.typical_semi_axes = typicalSemiAxes(m.object.category);
-    const BoxEllipsoidResult r = buildEllipsoidFromBoxes(K_, track.views, options_.boxes, prior);
+    const BoxEllipsoidResult r = buildEllipsoidFromBoxes(K_, track.views, options_.boxes, sizePrior(m.object.category));
     track.built_views = track.views.size();
     if (!r.ok()) {
       track.built.reset();  // boxes that no longer agree: out of the map until they do
@@ -507,10 +541,8 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     if (t.built) {
       e = t.built->object.ellipsoid;
     } else if (keyframes_ - t.last_seen <= options_.track_window) {
-      BoxSizePrior prior;
-      prior.typical_semi_axes = typicalSemiAxes(t.label());
       const size_t recent = std::min(kPredictionViews, t.views.size());
-      expected = predictedBoxes(K_, {t.views.end() - static_cast<long>(recent), t.views.end()}, prior,
+      expected = predictedBoxes(K_, {t.views.end() - static_cast<long>(recent), t.views.end()}, sizePrior(t.label()),
                                 options_.boxes.min_baseline_deg, pose);
     } else if (const auto c = triangulateBoxCentres(K_, t.views)) {
       const BoxView& last = t.views.back();
@@ -601,7 +633,7 @@ ObjectMap Mapper::map() const {
   // envelope (0.5 m, 20 degrees): a camera may come back lower, higher or more tilted.
   const std::optional<Eigen::Vector3d> up =
       options_.mode == MappingMode::Voxel ? std::optional<Eigen::Vector3d>(upLocked()) : options_.boxes.up;
-  out.camera_envelope = CameraEnvelope::fromKeyframes(keyframe_poses_, up, 1.0, 30.0);
+  out.camera_envelope = CameraEnvelope::fromKeyframes(keyframe_poses_, up, 1.0 / options_.unit_metres, 30.0);
   return out;
 }
 

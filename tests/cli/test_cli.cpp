@@ -486,6 +486,12 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                                       "/keyframes.groundtruth.txt --detections " + d +
                                       "/keyframes.detections.json --out " + out},
       {"boxes map of frames without a pose", boxes_of_other_frames},
+      {"voxel map in another unit", "map --camera " + d + "/camera.yaml --trajectory " + d +
+                                        "/keyframes.groundtruth.txt --detections " + d +
+                                        "/keyframes.detections.json --unit-metres 2 --out " + out},
+      {"unit of zero", "map --mode boxes --camera " + d + "/camera.yaml --trajectory " + d +
+                           "/keyframes.groundtruth.txt --detections " + d +
+                           "/keyframes.detections.json --unit-metres 0 --out " + out},
       {"unknown preset", "simulate --preset mars --out " + dir.path("scene")},
       {"zero gravity", reloc + "--map " + d + "/map.json --detections " + d +
                            "/keyframes.detections.json --camera-up 0,0,0 --map-up 0,0,1"},

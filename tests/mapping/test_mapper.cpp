@@ -676,6 +676,54 @@ TEST(Mapper, ALoopClosureJoinsTwoVoxelModelsOfOneObject) {
   EXPECT_EQ(mapper.objects()[0].observations, 12);
 }
 
+// A monocular host's poses in a unit of its own (here 2.5 m: every translation divided by it),
+// with that unit given, make the metric map in that unit: the size prior, its bounds and the
+// envelope's margin are divided by it, and the box fit is the same fit at another scale.
+TEST(Mapper, BoxMapsOfPosesInAnotherUnitAreTheMetricMapInThatUnit) {
+  const test::SimSequence seq = boxSequence();
+  const double unit = 2.5;
+  MapperOptions in_unit = boxesMode();
+  in_unit.unit_metres = unit;
+  Mapper metric(seq.K, boxesMode()), scaled(seq.K, in_unit), unaware(seq.K, boxesMode());
+  for (const auto& kf : seq.keyframes) {
+    const Pose pose(kf.pose.rotation(), kf.pose.translation() / unit);
+    metric.addKeyframe(kf.pose, kf.detections);
+    scaled.addKeyframe(pose, kf.detections);
+    unaware.addKeyframe(pose, kf.detections);
+  }
+  metric.finish();
+  scaled.finish();
+  unaware.finish();
+  const ObjectMap expected = metric.map(), got = scaled.map();
+  ASSERT_GE(expected.objects.size(), 3u);
+  ASSERT_EQ(got.objects.size(), expected.objects.size());
+  double largest_difference = 0.0;
+  for (size_t i = 0; i < got.objects.size(); ++i) {
+    const Ellipsoid &g = got.objects[i].ellipsoid, &e = expected.objects[i].ellipsoid;
+    largest_difference =
+        std::max({largest_difference, (unit * g.center() - e.center()).norm(), (unit * g.axes() - e.axes()).norm()});
+  }
+  EXPECT_LT(largest_difference, 1e-5);
+  ASSERT_TRUE(got.camera_envelope && expected.camera_envelope);
+  EXPECT_NEAR(unit * got.camera_envelope->min_height, expected.camera_envelope->min_height, 1e-9);
+  // Unaware of the unit, the prior pulls the sizes towards metres taken for units: not the same map.
+  double unaware_difference = 0.0;
+  const ObjectMap off = unaware.map();
+  for (size_t i = 0; i < std::min(off.objects.size(), expected.objects.size()); ++i)
+    unaware_difference = std::max(
+        unaware_difference, (unit * off.objects[i].ellipsoid.axes() - expected.objects[i].ellipsoid.axes()).norm());
+  EXPECT_GT(unaware_difference, 0.01);
+  // The unit the objects tell scales with the poses' (how near it comes on real data: the Python
+  // test on fr3; the simulator's objects are not of their categories' typical sizes).
+  const std::optional<double> estimate = scaled.estimatedUnitMetres(3), in_metres = metric.estimatedUnitMetres(3);
+  ASSERT_TRUE(estimate && in_metres);
+  EXPECT_NEAR(*estimate, unit * *in_metres, 1e-6);
+  MapperOptions voxel_unit;
+  voxel_unit.unit_metres = 2.0;
+  EXPECT_NE(voxel_unit.validate().find("unit_metres must be 1 in voxel mode"), std::string::npos);
+  EXPECT_FALSE(Mapper(seq.K).estimatedUnitMetres());
+}
+
 TEST(Mapper, KeyframePosesOfAnotherCountOrNotFiniteAreRefused) {
   const test::SimSequence seq = test::makeSimSequence(sim::ScenePreset::Sparse, 1, 3, sim::NoiseModel());
   Mapper mapper(seq.K);

@@ -61,6 +61,12 @@ struct MapperOptions {
   bool estimate_up_from_floor = false;
   FloorOptions floor;
   long min_mask_pixels = 30;  ///< smaller masks are ignored
+  /// Boxes mode: the length of the world's unit (the keyframe poses') in metres. A monocular
+  /// SLAM system's poses have a unit of their own (its first baseline, say), unknown in metres;
+  /// the size prior (each category's typical size, in metres) is divided by it, and so is the
+  /// camera envelope's margin of 1 m. Mapper::estimatedUnitMetres() reads it off the objects.
+  /// Voxel mode: 1 (the depth images are in metres).
+  double unit_metres = 1.0;
   /// The keyframes (detections, and depth images in voxel mode) are raw images of this distorted
   /// lens (core/distortion.hpp): each box is undistorted to the pinhole image the ellipsoids
   /// project into (whether the image border cuts it judged on the raw box), and each mask and
@@ -134,6 +140,15 @@ class Mapper {
   /// is not finite.
   void updateKeyframePoses(const std::vector<Pose>& poses);
 
+  /// Boxes mode: the world's unit in metres that the objects tell, for poses of unknown scale
+  /// (MapperOptions::unit_metres): over the objects the rays of their boxes triangulate (not
+  /// placed by their typical size), the median of their category's typical size (half its two
+  /// larger extents) over their size in the world's unit (their boxes' half-size at the
+  /// triangulated depth). The rays do not depend on the unit assumed, but the tracking does: a
+  /// unit far off splits objects, so map the keyframes again with the estimate until it settles
+  /// (two or three passes). nullopt with fewer than `min_objects` such objects, or in voxel mode.
+  std::optional<double> estimatedUnitMetres(int min_objects = 5) const;
+
   /// The objects in the map (those with an ellipsoid), in the order they were created, and
   /// the camera envelope of the keyframes (heights and tilts along the world's up in voxel
   /// mode or with boxes.up, else along their mean image-up; widened by 1 m and 30 degrees;
@@ -178,6 +193,8 @@ class Mapper {
   /// pair once the keyframes moved.
   void mergeDuplicateVoxelTracks(bool every_pair = false);
   void rebuild(Track& track) const;
+  /// Boxes mode: the size prior of a category, in the world's unit.
+  BoxSizePrior sizePrior(int category) const;
   /// The world's up: the floor's normal when estimated, else the options' (mutex_ held).
   Eigen::Vector3d upLocked() const;
 
