@@ -68,7 +68,7 @@ struct MapArgs {
   std::string holdout;     ///< detections of frames left out of the map, to measure its quality
   std::vector<double> up;  ///< the world's up direction, when known
   bool undistort = false;  ///< the detections and depth images are raw images of the camera's distorted lens
-  double unit_metres = 1.0;  ///< boxes mode: the trajectory's unit in metres
+  std::string unit_metres = "1";  ///< boxes mode: the trajectory's unit in metres, or "auto"
 };
 CLI::App* addMapCommand(CLI::App& app, MapArgs& a);
 void map(const MapArgs& a, const Console& console);

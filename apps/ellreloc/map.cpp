@@ -4,10 +4,14 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
+#include <utility>
 
 #include "commands.hpp"
 #include "ellreloc/core/coco.hpp"
@@ -87,11 +91,13 @@ void printSummary(const ObjectMap& map, const std::vector<std::string>& dropped,
         "tilts %.0f to %.0f deg\n",
         e->min_height * unit_metres, e->max_height * unit_metres, e->up(0), e->up(1), e->up(2), e->min_tilt_deg,
         e->max_tilt_deg);
-  if (unit_told)
+  if (unit_told && std::abs(*unit_told / unit_metres - 1.0) <= 0.02)
+    std::printf("  the objects' sizes tell %.3g m per unit of the trajectory, the unit taken\n", *unit_told);
+  else if (unit_told)
     std::printf(
-        "  the objects' sizes tell %.3g m per unit of the trajectory (taken: %.3g; for poses of unknown scale, "
-        "map again with --unit-metres %.3g)\n",
-        *unit_told, unit_metres, *unit_told);
+        "  the objects' sizes tell %.3g m per unit of the trajectory (taken: %.3g; for poses of unknown "
+        "scale, --unit-metres auto)\n",
+        *unit_told, unit_metres);
 }
 
 }  // namespace
@@ -118,9 +124,8 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
               "the detections (and depth images) are raw images of a distorted lens: undistort them with the "
               "--camera file's Camera.k1, k2, p1, p2, k3 (left out: 0)");
   m->add_option("--unit-metres", a.unit_metres,
-                "boxes mode: the length of the trajectory's unit in metres, for a monocular SLAM system's poses "
-                "(the summary gives the unit the objects' sizes tell)")
-      ->check(CLI::Range(1e-6, 1e6))
+                "boxes mode: the length of the trajectory's unit in metres, for a monocular SLAM system's poses; "
+                "auto: the unit the objects' sizes tell (the frames mapped again until it settles)")
       ->capture_default_str();
   m->add_option("--holdout-every", a.holdout_every,
                 "leave every N-th frame out of the map and report how well the map explains its boxes")
@@ -135,6 +140,96 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
   return m;
 }
 
+/// What `map` reads besides the camera, and the frames it leaves out of the map.
+struct MapInputs {
+  std::vector<io::StampedPose> trajectory;
+  io::TimeIndex by_time;
+  std::vector<DetectionFrame> frames;
+  io::AssociationIndex association_of;
+  fs::path detections_dir;
+};
+
+/// One pass over the frames: the mapper, and what it could not use.
+struct MappingPass {
+  std::unique_ptr<Mapper> mapper;
+  int used = 0, no_pose = 0, no_depth = 0;
+  std::vector<PosedDetections> held_out;  // --holdout-every's frames
+};
+
+MappingPass mapFrames(const MapArgs& a, const MapperOptions& options, const Intrinsics& K, const MapInputs& in,
+                      const Console& console) {
+  MappingPass pass;
+  pass.mapper = std::make_unique<Mapper>(K, options);
+  for (size_t i = 0; i < in.frames.size(); ++i) {
+    const DetectionFrame& f = in.frames[i];
+    if (a.holdout_every > 0 && i % static_cast<size_t>(a.holdout_every) == static_cast<size_t>(a.holdout_every) - 1) {
+      std::vector<PosedDetections> one = posedFrames({f}, in.trajectory, in.by_time, options.lens);
+      pass.held_out.insert(pass.held_out.end(), one.begin(), one.end());
+      continue;
+    }
+    // The frame's depth: the association naming the same colour image, else the nearest time.
+    const io::Association* assoc = in.association_of.find((in.detections_dir / f.file_name).string(), f.timestamp());
+    const std::optional<double> t = assoc ? std::optional<double>(assoc->rgb_time) : f.timestamp();
+    const std::optional<size_t> k = t ? in.by_time.nearest(*t) : std::nullopt;
+    if (!k) {
+      ++pass.no_pose;
+      continue;
+    }
+    DepthImage depth;
+    if (options.mode == MappingMode::Voxel) {
+      if (!assoc) {
+        ++pass.no_depth;
+        continue;
+      }
+      depth = io::readDepthPng(assoc->depth_path);
+    }
+    try {
+      pass.mapper->addKeyframe(in.trajectory[*k].pose, f.detections,
+                               options.mode == MappingMode::Voxel ? &depth : nullptr);
+    } catch (const Error& e) {
+      throw Error(a.detections + ": " + f.file_name + ": " + e.what());
+    }
+    ++pass.used;
+    console.progress("map", i + 1, in.frames.size());
+  }
+  console.endProgress();
+  if (pass.used == 0)
+    throw Error(a.detections + ": no frame has " +
+                (options.mode == MappingMode::Voxel ? "both a pose in " + a.trajectory + " and its depth"
+                                                    : "a pose in " + a.trajectory + " (within 0.02 s)"));
+  pass.mapper->finish();
+  return pass;
+}
+
+/// --unit-metres: a length in metres, or nullopt for "auto".
+std::optional<double> unitGiven(const std::string& text, MappingMode mode) {
+  char* end = nullptr;
+  const double unit = text == "auto" ? 0.0 : std::strtod(text.c_str(), &end);
+  if (text != "auto" && (text.empty() || *end != '\0' || !(unit >= 1e-6 && unit <= 1e6)))
+    throw Error("--unit-metres: expected metres (1e-6 to 1e6) or auto, got '" + text + "'");
+  if (mode == MappingMode::Voxel && unit != 1.0)
+    throw Error("--unit-metres: boxes mode only (voxel mode's depth images are in metres)");
+  if (text == "auto") return std::nullopt;
+  return unit;
+}
+
+/// With --unit-metres auto, the frames are mapped taking a unit of 1 m, then again with the unit
+/// the objects tell, until it settles (within 2%, at most four passes in all).
+MappingPass mapInTheUnit(const MapArgs& a, MapperOptions& options, const Intrinsics& K, const MapInputs& in,
+                         const Console& console) {
+  const std::optional<double> given = unitGiven(a.unit_metres, options.mode);
+  options.unit_metres = given.value_or(1.0);
+  MappingPass pass = mapFrames(a, options, K, in, console);
+  for (int passes = 1; !given && passes < 4; ++passes) {
+    const std::optional<double> told = pass.mapper->estimatedUnitMetres();
+    if (!told || std::abs(*told / options.unit_metres - 1.0) <= 0.02) break;
+    options.unit_metres = *told;
+    if (!console.quiet) std::printf("mapping again in a unit of %.3g m\n", *told);
+    pass = mapFrames(a, options, K, in, console);
+  }
+  return pass;
+}
+
 void map(const MapArgs& a, const Console& console) {
   checkPaths({{"--out", a.out}}, {{"--camera", a.camera},
                                   {"--associations", a.associations},
@@ -146,9 +241,7 @@ void map(const MapArgs& a, const Console& console) {
   if (a.undistort) options.lens = io::readLens(a.camera);
   const Intrinsics K = options.lens ? options.lens->intrinsics : io::readCamera(a.camera);
   if (!parseMappingMode(a.mode, &options.mode)) throw Error("--mode: unknown mode '" + a.mode + "' (voxel, boxes)");
-  if (options.mode == MappingMode::Voxel && a.unit_metres != 1.0)
-    throw Error("--unit-metres: boxes mode only (voxel mode's depth images are in metres)");
-  options.unit_metres = a.unit_metres;
+  unitGiven(a.unit_metres, options.mode);  // refused before any file is read
   if (!a.up.empty()) {
     const Eigen::Vector3d up(a.up[0], a.up[1], a.up[2]);
     if (!up.allFinite() || !(up.norm() > 1e-9)) throw Error("--up: not a direction (finite, non-zero)");
@@ -156,59 +249,23 @@ void map(const MapArgs& a, const Console& console) {
     options.boxes.up = up.normalized();
   }
   if (!a.undistort && !console.quiet) mentionTheLens(a.camera);
-  const std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
-  const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
+  std::vector<io::StampedPose> trajectory = io::readTumTrajectory(a.trajectory);
+  std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   std::vector<io::Association> associations;
   if (!a.associations.empty()) associations = io::readAssociations(a.associations);
   if (options.mode == MappingMode::Voxel && associations.empty())
     throw Error(a.associations.empty() ? std::string("--associations: voxel mode needs the depth images")
                                        : a.associations + ": no association");
-  const fs::path detections_dir = fs::path(a.detections).parent_path();
-  const io::AssociationIndex association_of(associations);
   const io::TimeIndex by_time = io::timeIndex(trajectory);
+  const MapInputs in{std::move(trajectory), by_time, std::move(frames), io::AssociationIndex(std::move(associations)),
+                     fs::path(a.detections).parent_path()};
 
-  Mapper mapper(K, options);
   std::vector<PosedDetections> held_out;
-  if (!a.holdout.empty()) held_out = posedFrames(io::readDetections(a.holdout), trajectory, by_time, options.lens);
-  int used = 0, no_pose = 0, no_depth = 0;
-  for (size_t i = 0; i < frames.size(); ++i) {
-    const DetectionFrame& f = frames[i];
-    if (a.holdout_every > 0 && i % static_cast<size_t>(a.holdout_every) == static_cast<size_t>(a.holdout_every) - 1) {
-      std::vector<PosedDetections> one = posedFrames({f}, trajectory, by_time, options.lens);
-      held_out.insert(held_out.end(), one.begin(), one.end());
-      continue;
-    }
-    // The frame's depth: the association naming the same colour image, else the nearest time.
-    const io::Association* assoc = association_of.find((detections_dir / f.file_name).string(), f.timestamp());
-    const std::optional<double> t = assoc ? std::optional<double>(assoc->rgb_time) : f.timestamp();
-    const std::optional<size_t> k = t ? by_time.nearest(*t) : std::nullopt;
-    if (!k) {
-      ++no_pose;
-      continue;
-    }
-    DepthImage depth;
-    if (options.mode == MappingMode::Voxel) {
-      if (!assoc) {
-        ++no_depth;
-        continue;
-      }
-      depth = io::readDepthPng(assoc->depth_path);
-    }
-    try {
-      mapper.addKeyframe(trajectory[*k].pose, f.detections, options.mode == MappingMode::Voxel ? &depth : nullptr);
-    } catch (const Error& e) {
-      throw Error(a.detections + ": " + f.file_name + ": " + e.what());
-    }
-    ++used;
-    console.progress("map", i + 1, frames.size());
-  }
-  console.endProgress();
-  if (used == 0)
-    throw Error(a.detections + ": no frame has " +
-                (options.mode == MappingMode::Voxel ? "both a pose in " + a.trajectory + " and its depth"
-                                                    : "a pose in " + a.trajectory + " (within 0.02 s)"));
-  mapper.finish();
-  ObjectMap result = mapper.map();
+  if (!a.holdout.empty())
+    held_out = posedFrames(io::readDetections(a.holdout), in.trajectory, in.by_time, options.lens);
+  MappingPass pass = mapInTheUnit(a, options, K, in, console);
+  held_out.insert(held_out.end(), pass.held_out.begin(), pass.held_out.end());
+  ObjectMap result = pass.mapper->map();
   // Objects relocalization could not use (mapObjectProblem) are left out of the file, and said.
   std::vector<std::string> dropped;
   result.objects.erase(std::remove_if(result.objects.begin(), result.objects.end(),
@@ -222,12 +279,12 @@ void map(const MapArgs& a, const Console& console) {
   if (!console.quiet) {
     // Boxes mode reads no depth: only voxel mode can miss one.
     const std::string no_depth_text =
-        options.mode == MappingMode::Voxel ? ", " + std::to_string(no_depth) + " without depth" : "";
+        options.mode == MappingMode::Voxel ? ", " + std::to_string(pass.no_depth) + " without depth" : "";
     std::printf("wrote %s: %s from %s (%s mode; %s without pose%s)\n", a.out.c_str(),
-                counted(result.objects.size(), "object").c_str(), counted(used, "keyframe").c_str(), a.mode.c_str(),
-                counted(no_pose, "frame").c_str(), no_depth_text.c_str());
-    printSummary(result, dropped, mapper.stats(), options.min_observations, a.unit_metres,
-                 mapper.estimatedUnitMetres());
+                counted(result.objects.size(), "object").c_str(), counted(pass.used, "keyframe").c_str(),
+                a.mode.c_str(), counted(pass.no_pose, "frame").c_str(), no_depth_text.c_str());
+    printSummary(result, dropped, pass.mapper->stats(), options.min_observations, options.unit_metres,
+                 pass.mapper->estimatedUnitMetres());
   }
   if (!a.holdout.empty() || a.holdout_every > 0) printQuality(measureMapQuality(result, K, held_out));
 }
