@@ -140,7 +140,7 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
   return m;
 }
 
-/// What `map` reads besides the camera, and the frames it leaves out of the map.
+/// What `map` reads besides the camera: the trajectory, the frames and where their depth images are.
 struct MapInputs {
   std::vector<io::StampedPose> trajectory;
   io::TimeIndex by_time;
