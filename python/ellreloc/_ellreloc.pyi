@@ -66,6 +66,14 @@ class CameraEnvelope:
     def admits(self, pose: Pose) -> bool: ...
 
 
+class Cuboid:
+    """The yaw-aligned cuboid a voxel object's ellipsoid is inscribed in."""
+    center: numpy.ndarray
+    half: numpy.ndarray
+    rotation: numpy.ndarray
+    def corners(self) -> numpy.ndarray: """the eight corners, (8, 3)"""
+
+
 class Detection:
     """One detected object: box, category, score, and optionally an instance mask (numpy array, COCO RLE dict or RleMask), a polygon or a ready-made ellipse."""
     def __init__(self, category_id: int, bbox: Box | ArrayLike, score: float = ..., mask: MaskLike = ..., polygon: ArrayLike = ..., ellipse: Optional[Ellipse] = ..., object_id: Optional[int] = ...) -> None: ...
@@ -275,6 +283,16 @@ class MapQuality:
     mean_best_iou: float
 
 
+class MappedObject:
+    """A mapped object with what the mapper knows about it."""
+    object: MapObject
+    cuboid: Optional[Cuboid]
+    observations: int
+    depth_from_size: bool
+    voxels: int
+    memory_bytes: int
+
+
 class Mapper:
     """Builds an object map from keyframes: voxel mode (depth + masks, the paper) or boxes mode (boxes and poses)."""
     def __init__(self, camera: Intrinsics, options: Optional[MapperOptions] = ..., mode: str | MappingMode | None = ...) -> None: ...
@@ -283,6 +301,7 @@ class Mapper:
     def update_keyframe_poses(self, poses: Sequence[Pose]) -> None: """The host moved its keyframes (bundle adjustment, loop closure): the world->camera pose of every keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves each object with the keyframe that saw it last; objects that now coincide are joined. On error the map is unchanged."""
     def estimated_unit_metres(self, min_objects: int = ...) -> Optional[float]: """Boxes mode: the poses' unit in metres that the triangulated objects' sizes tell (None with fewer than min_objects of them): map again with it as MapperOptions.unit_metres until it settles."""
     def map(self) -> ObjectMap: """The current object map."""
+    def objects(self) -> list[MappedObject]: """The objects in the map with what the mapper knows about each (MappedObject), in map order."""
     stats: MapperStats
     camera: Intrinsics
     options: MapperOptions

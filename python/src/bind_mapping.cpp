@@ -4,6 +4,9 @@
 
 #include <pybind11/stl.h>
 
+#include <array>
+#include <vector>
+
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "ellreloc/mapping/map_quality.hpp"
@@ -111,6 +114,27 @@ void bindMapperClass(py::module_& m) {
       .def_readonly("matched_3d", &KeyframeReport::matched_3d)
       .def_readonly("new_objects", &KeyframeReport::new_objects)
       .def_readonly("ignored", &KeyframeReport::ignored);
+  py::class_<Cuboid>(m, "Cuboid", "The yaw-aligned cuboid a voxel object's ellipsoid is inscribed in.")
+      .def_property_readonly("center", [](const Cuboid& c) { return toArray(c.center); })
+      .def_property_readonly(
+          "half", [](const Cuboid& c) { return toArray(c.half); }, "half extents")
+      .def_property_readonly(
+          "rotation", [](const Cuboid& c) { return toArray(c.rotation); }, "its axes, as columns")
+      .def(
+          "corners",
+          [](const Cuboid& c) {
+            const std::array<Eigen::Vector3d, 8> k = c.corners();
+            return rowsToArray(std::vector<Eigen::Vector3d>(k.begin(), k.end()));
+          },
+          "the eight corners, (8, 3)");
+  py::class_<MappedObject>(m, "MappedObject", "A mapped object with what the mapper knows about it.")
+      .def_readonly("object", &MappedObject::object, "id, category, label histogram, ellipsoid")
+      .def_readonly("cuboid", &MappedObject::cuboid, "voxel mode: the cuboid its ellipsoid is inscribed in")
+      .def_readonly("observations", &MappedObject::observations)
+      .def_readonly("depth_from_size", &MappedObject::depth_from_size,
+                    "boxes mode: placed by its category's typical size (too narrow a baseline)")
+      .def_readonly("voxels", &MappedObject::voxels)
+      .def_readonly("memory_bytes", &MappedObject::memory_bytes);
   py::class_<MapperStats>(m, "MapperStats")
       .def_readonly("keyframes", &MapperStats::keyframes)
       .def_property_readonly("up", [](const MapperStats& s) { return toArray(s.up); })
@@ -158,6 +182,8 @@ void bindMapperClass(py::module_& m) {
            "Boxes mode: the poses' unit in metres that the triangulated objects' sizes tell (None with fewer than "
            "min_objects of them): map again with it as MapperOptions.unit_metres until it settles.")
       .def("map", &Mapper::map, py::call_guard<py::gil_scoped_release>(), "The current object map.")
+      .def("objects", &Mapper::objects, py::call_guard<py::gil_scoped_release>(),
+           "The objects in the map with what the mapper knows about each (MappedObject), in map order.")
       .def_property_readonly("stats", &Mapper::stats)
       .def_property_readonly("camera", &Mapper::intrinsics)
       .def_property_readonly("options", &Mapper::options, "A copy.");

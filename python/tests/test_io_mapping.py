@@ -167,6 +167,8 @@ def test_box_mapping_of_real_frames_equals_the_command_line(data_dir, cli, tmp_p
     mapper.finish()
     E.write_map(tmp_path / "python.json", mapper.map())
     assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    placed = [o for o in mapper.objects() if o.depth_from_size]
+    assert 0 < len(placed) == mapper.stats.placed_by_size and all(o.cuboid is None for o in mapper.objects())
 
 
 def test_box_mapping_through_a_lens_equals_the_command_line(data_dir, cli, tmp_path):

@@ -226,6 +226,16 @@ def test_mapping_reports_and_stats(office):
     stats = mapper.stats
     assert isinstance(stats, E.MapperStats) and stats.keyframes == 6 and stats.objects + stats.candidates > 5
     assert stats.voxels > 0 and stats.memory_bytes > 0 and stats.up.tolist() == [0, 0, 1]
+    objects = mapper.objects()
+    assert [o.object.id for o in objects] == [o.id for o in mapper.map().objects] and len(objects) == stats.objects
+    for o in objects:  # voxel mode: each ellipsoid is the one inscribed in its cuboid
+        assert isinstance(o, E.MappedObject) and o.observations >= 3 and o.voxels > 0 and not o.depth_from_size
+        assert isinstance(o.cuboid, E.Cuboid) and o.memory_bytes > 0
+        np.testing.assert_allclose(o.cuboid.center, o.object.ellipsoid.center, atol=1e-9)
+        np.testing.assert_allclose(sorted(o.cuboid.half), sorted(o.object.ellipsoid.axes), rtol=1e-9)
+        corners = o.cuboid.corners()
+        assert corners.shape == (8, 3)
+        np.testing.assert_allclose(corners.mean(axis=0), o.cuboid.center, atol=1e-9)
     quality = E.map_quality(mapper.map(), camera, [(pose, [])])
     assert isinstance(quality, E.MapQuality) and quality.boxes == 0 and quality.explained == 0
     assert quality.mean_best_iou == 0
