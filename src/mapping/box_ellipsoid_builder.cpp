@@ -158,7 +158,7 @@ std::optional<Eigen::Vector3d> centreAtTypicalSize(const Intrinsics& K, const st
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const BoxView& v : views) {
     const Eigen::Vector3d b = K.bearing(Eigen::Vector2d(0.5 * (v.box.x1 + v.box.x2), 0.5 * (v.box.y1 + v.box.y2)));
-    const double radius_per_depth = 0.25 * (v.box.width() / K.fx + v.box.height() / K.fy);
+    const double radius_per_depth = boxRadiusPerDepth(K, v.box);
     if (!(b.z() > 0.0) || !(radius_per_depth > 0.0)) return std::nullopt;
     const double depth = typical_radius / radius_per_depth;
     sum += v.pose.center() + v.pose.rotation().transpose() * (b / b.z() * depth);
@@ -278,7 +278,7 @@ BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vecto
       out.reason = "triangulated centre behind a camera";
       return out;
     }
-    radii.push_back(0.25 * (v.box.width() / K.fx + v.box.height() / K.fy) * z);
+    radii.push_back(boxRadiusPerDepth(K, v.box) * z);
   }
   if (!fitEllipsoid(K, views, options, prior, *centre, median(radii), &out)) return out;
   std::vector<double> ious;

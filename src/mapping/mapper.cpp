@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <limits>
 #include <mutex>
 #include <tuple>
@@ -339,7 +338,7 @@ std::optional<double> Mapper::estimatedUnitMetres(int min_objects) const {
     std::vector<double> radii;
     for (const BoxView& v : t.views) {
       const double z = v.pose.transform(*centre).z();
-      if (z > 0.0) radii.push_back(0.25 * (v.box.width() / K_.fx + v.box.height() / K_.fy) * z);
+      if (z > 0.0) radii.push_back(boxRadiusPerDepth(K_, v.box) * z);
     }
     const double radius = median(radii);
     const Eigen::Vector3d typical = typicalSemiAxes(t.built->object.category);  // smallest first
@@ -547,7 +546,7 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     } else if (const auto c = triangulateBoxCentres(K_, t.views)) {
       const BoxView& last = t.views.back();
       const double z = last.pose.transform(*c).z();
-      const double r = 0.25 * (last.box.width() / K_.fx + last.box.height() / K_.fy) * z;
+      const double r = boxRadiusPerDepth(K_, last.box) * z;
       if (r > 0.0) e = Ellipsoid(*c, Eigen::Vector3d::Constant(r), Eigen::Matrix3d::Identity());
     }
     if (e) {
@@ -572,7 +571,6 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     }
     t->views.push_back({pose, d.bbox, cut.empty() ? std::nullopt : std::optional<bool>(cut[used[k]])});
     t->view_keyframes.push_back(keyframes_);
-    t->keyframes_seen.push_back(keyframes_);
     observed(*t, d);
   }
   mergeDuplicateBoxTracks();
@@ -585,8 +583,12 @@ void Mapper::mergeDuplicateBoxTracks() {
   // unless a keyframe detected both: a detector gives one box per object, so two boxes of one
   // image are two objects (a book on another, two bottles side by side).
   const auto detected_together = [](const Track& a, const Track& b) {
-    auto i = a.keyframes_seen.begin(), j = b.keyframes_seen.begin();
-    while (i != a.keyframes_seen.end() && j != b.keyframes_seen.end()) {
+    // Each track's keyframes ascending (a joined track's views are its own, then the other's).
+    std::vector<int> seen_a = a.view_keyframes, seen_b = b.view_keyframes;
+    std::sort(seen_a.begin(), seen_a.end());
+    std::sort(seen_b.begin(), seen_b.end());
+    auto i = seen_a.begin(), j = seen_b.begin();
+    while (i != seen_a.end() && j != seen_b.end()) {
       if (*i == *j) return true;
       if (*i < *j)
         ++i;
@@ -604,10 +606,6 @@ void Mapper::mergeDuplicateBoxTracks() {
       if ((ea.center() - eb.center()).norm() > reach || detected_together(a, b)) continue;
       a.views.insert(a.views.end(), b.views.begin(), b.views.end());
       a.view_keyframes.insert(a.view_keyframes.end(), b.view_keyframes.begin(), b.view_keyframes.end());
-      std::vector<int> seen;
-      std::merge(a.keyframes_seen.begin(), a.keyframes_seen.end(), b.keyframes_seen.begin(), b.keyframes_seen.end(),
-                 std::back_inserter(seen));
-      a.keyframes_seen = std::move(seen);
       for (const auto& [category, weight] : b.labels) a.labels[category] += weight;
       a.observations += b.observations;
       a.last_seen = std::max(a.last_seen, b.last_seen);

@@ -97,6 +97,12 @@ struct BoxEllipsoidResult {
 BoxEllipsoidResult buildEllipsoidFromBoxes(const Intrinsics& K, const std::vector<BoxView>& views,
                                            const BoxEllipsoidOptions& options = {}, const BoxSizePrior& prior = {});
 
+/// The half-size of a box in the normalised image (the mean of its half-width over fx and
+/// half-height over fy): the radius, per unit of depth, of the object it boxes.
+inline double boxRadiusPerDepth(const Intrinsics& K, const Box& box) {
+  return 0.25 * (box.width() / K.fx + box.height() / K.fy);
+}
+
 /// The centre least-squares closest to the rays through the box centres (nullopt when the
 /// rays are parallel or the input is invalid). Exposed for the mapper's association.
 std::optional<Eigen::Vector3d> triangulateBoxCentres(const Intrinsics& K, const std::vector<BoxView>& views);

@@ -165,7 +165,6 @@ class Mapper {
     VoxelObject voxels;
     std::vector<BoxView> views;       // boxes mode
     std::vector<int> view_keyframes;  // boxes mode: the keyframe of each view
-    std::vector<int> keyframes_seen;  // boxes mode: the keyframes that detected it, ascending
     std::map<int, double> labels;
     int observations = 0;
     int last_seen = -1;
