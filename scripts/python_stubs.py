@@ -41,6 +41,7 @@ ARGUMENT_TYPES = {
     "detections": "Sequence[Detection]",
     "matches": "Sequence[EllipseMatch | tuple[Ellipse, Ellipsoid]]",
     "poses": "Sequence[StampedPose | tuple[float | str, Pose]]",
+    "update_keyframe_poses.poses": "Sequence[Pose]",
     "map_quality.frames": "Sequence[tuple[Pose, Sequence[Detection]]]",
     "observe_frame.frame": "DetectionFrame | Sequence[Detection]",
 }

@@ -117,6 +117,7 @@ struct EvaluateArgs {
   std::string groundtruth;
   std::vector<std::string> estimates;  ///< FILE or FILE:LABEL
   std::string detections, plot, map, per_frame;
+  double unit_metres = 0.0;  ///< metres per unit of the trajectories; 0: the --map's unit_metres, else 1
 };
 /// One method's errors on the query frames.
 struct MethodEvaluation {

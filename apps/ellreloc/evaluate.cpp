@@ -27,6 +27,9 @@ CLI::App* addEvaluateCommand(CLI::App& app, EvaluateArgs& a) {
       ->check(CLI::ExistingFile);
   e->add_option("--map", a.map, "map JSON or OA-SLAM text map: its objects' footprints in the plot's top view")
       ->check(CLI::ExistingFile);
+  e->add_option("--unit-metres", a.unit_metres,
+                "metres per unit of the trajectories, for poses of a monocular SLAM system's map (default: the --map's "
+                "unit_metres, else 1)");
   e->add_option("--plot", a.plot,
                 "cumulative error curves and a top view of every method: SVG for a .svg name (text stays text), "
                 "else PNG");
@@ -95,6 +98,9 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
   }
   if (estimates.empty()) throw Error("--estimate: give at least one");
   checkPaths({{"--plot", a.plot}, {"--per-frame", a.per_frame}}, inputs);
+  if (!(a.unit_metres == 0.0 || validUnitMetres(a.unit_metres)))
+    throw Error("--unit-metres: expected a length of 1e-6 to 1e6 metres");
+  const double unit = a.unit_metres > 0.0 ? a.unit_metres : a.map.empty() ? 1.0 : io::readMap(a.map).unit_metres;
   const std::vector<io::StampedPose> gt = io::readTumTrajectory(a.groundtruth);
   // The query frames: those of the detections file when given, else every ground-truth pose.
   Evaluation e;
@@ -129,7 +135,7 @@ Evaluation evaluateEstimates(const EvaluateArgs& a) {
     const io::TimeIndex by_time = io::timeIndex(est);
     for (size_t i = 0; i < e.frames.size(); ++i) {
       const auto k = by_time.nearest(times[i], kSameTime);
-      m.errors.push_back(k ? std::optional(poseError(est[*k].pose, gt[truth_index[i]].pose)) : std::nullopt);
+      m.errors.push_back(k ? std::optional(poseError(est[*k].pose, gt[truth_index[i]].pose, unit)) : std::nullopt);
       m.centres.push_back(k ? std::optional(est[*k].pose.center()) : std::nullopt);
     }
     m.summary = summarize(m.errors);

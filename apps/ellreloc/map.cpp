@@ -270,7 +270,7 @@ void map(const MapArgs& a, const Console& console) {
   std::vector<std::string> dropped;
   result.objects.erase(std::remove_if(result.objects.begin(), result.objects.end(),
                                       [&](const MapObject& o) {
-                                        const std::string why = mapObjectProblem(o);
+                                        const std::string why = mapObjectProblem(o, result.unit_metres);
                                         if (!why.empty()) dropped.push_back(std::to_string(o.id) + " (" + why + ")");
                                         return !why.empty();
                                       }),

@@ -255,18 +255,20 @@ std::vector<RelocalizationResult> relocalizeFrames(
 /// frame better under our own cost, as given or refined (when refinement keeps it valid): we
 /// never generated it; "scoring failure" when our wrong pose scores better than both: the
 /// score cannot tell them apart.
-std::string diagnose(const RelocalizationResult& result, const ReferenceScore& reference, const Pose& truth) {
+std::string diagnose(const RelocalizationResult& result, const ReferenceScore& reference, const Pose& truth,
+                     double unit_metres) {
   if (result.status != RelocalizationStatus::Success) return "no pose";
-  if (poseError(result.pose, truth).valid()) return "valid";
+  if (poseError(result.pose, truth, unit_metres).valid()) return "valid";
   double best = reference.given.cost;
-  if (reference.refined.status == RelocalizationStatus::Success && poseError(reference.refined.pose, truth).valid())
+  if (reference.refined.status == RelocalizationStatus::Success &&
+      poseError(reference.refined.pose, truth, unit_metres).valid())
     best = std::min(best, reference.refined.cost);
   return best < result.cost ? "search failure" : "scoring failure";
 }
 
 /// The options of --method, --max-time-ms, --envelope, --max-tilt and --no-map-envelope; `policy`
-/// gets the method's default.
-RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* policy_out) {
+/// gets the method's default. `unit_metres`: the map's.
+RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, double unit_metres, std::string* policy_out) {
   RelocalizerOptions options;
   if (a.method == "oa-slam") {
     options = RelocalizerOptions::oaSlam();
@@ -290,7 +292,7 @@ RelocalizerOptions relocalizerOptions(const RelocalizeArgs& a, std::string* poli
     for (const io::StampedPose& p : io::readTumTrajectory(a.envelope)) keyframes.push_back(p.pose);
     std::optional<Eigen::Vector3d> up;
     if (a.map_up.size() == 3) up = Eigen::Vector3d(a.map_up[0], a.map_up[1], a.map_up[2]);
-    options.envelope = CameraEnvelope::fromKeyframes(keyframes, up);
+    options.envelope = CameraEnvelope::fromKeyframes(keyframes, up, 0.5 / unit_metres);
     if (!options.envelope) throw Error(a.envelope + ": the envelope needs two poses and a non-zero up direction");
   }
   if (std::isnan(a.max_tilt_deg)) throw Error("--max-tilt: expected a number of degrees, not NaN");
@@ -327,7 +329,7 @@ std::vector<double> frameTimestamps(const std::vector<DetectionFrame>& frames, c
 /// Each frame's --near region: about the latest --near pose at or before the frame's timestamp,
 /// none for a frame before the first; `without` counts those.
 std::vector<std::optional<PoseRegion>> nearRegions(const RelocalizeArgs& a, const std::vector<double>& timestamps,
-                                                   size_t* without) {
+                                                   double unit_metres, size_t* without) {
   std::vector<std::optional<PoseRegion>> regions(timestamps.size());
   *without = 0;
   if (a.near.empty()) return regions;
@@ -346,7 +348,7 @@ std::vector<std::optional<PoseRegion>> nearRegions(const RelocalizeArgs& a, cons
       ++*without;
       continue;
     }
-    regions[i] = PoseRegion{std::prev(after)->pose, a.near_radius_m, a.near_angle_deg};
+    regions[i] = PoseRegion{std::prev(after)->pose, a.near_radius_m / unit_metres, a.near_angle_deg};
   }
   return regions;
 }
@@ -450,12 +452,13 @@ nlohmann::json frameReport(const DetectionFrame& frame, const RelocalizationResu
                       {"inliers", ref.given.inliers.size()},
                       {"refined_score", ref.refined.cost},
                       {"refined_inliers", ref.refined.inliers.size()},
-                      {"refined_moved_cm", poseError(ref.refined.pose, *reference).position_cm},
+                      {"refined_moved_cm", poseError(ref.refined.pose, *reference, map.unit_metres).position_cm},
                       {"diagnosis", diagnosis}};
     // The first valid alternative, the one a host checking them in turn would stop at; the
     // rival is the first alternative.
     size_t first_valid = 0;
-    while (first_valid < r.alternatives.size() && !poseError(r.alternatives[first_valid].pose, *reference).valid())
+    while (first_valid < r.alternatives.size() &&
+           !poseError(r.alternatives[first_valid].pose, *reference, map.unit_metres).valid())
       ++first_valid;
     const bool any_valid = first_valid < r.alternatives.size();
     j["reference"]["valid_alternative"] = any_valid ? nlohmann::json(first_valid) : nlohmann::json();
@@ -496,7 +499,7 @@ void writeOverlays(const RelocalizeArgs& a, const ObjectMap& map, const Intrinsi
                   r.inliers.size(), c.observations.size(), r.evidence, margin, r.time_ms);
     c.text.push_back(line);
     if (has_pose && references[i]) {
-      const PoseError e = poseError(r.pose, *references[i]);
+      const PoseError e = poseError(r.pose, *references[i], map.unit_metres);
       std::snprintf(line, sizeof line, "against --reference: %.1f cm, %.1f deg (%s)", e.position_cm, e.rotation_deg,
                     e.valid() ? "valid" : "wrong");
       c.text.push_back(line);
@@ -581,9 +584,10 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
   const std::vector<DetectionFrame> frames = io::readDetections(a.detections);
   const std::vector<double> timestamps = frameTimestamps(frames, a.detections);
   std::string policy = a.policy;
-  const RelocalizerOptions options = relocalizerOptions(a, &policy);
+  const RelocalizerOptions options = relocalizerOptions(a, object_map.unit_metres, &policy);
   size_t without_region = 0;
-  const std::vector<std::optional<PoseRegion>> regions = nearRegions(a, timestamps, &without_region);
+  const std::vector<std::optional<PoseRegion>> regions =
+      nearRegions(a, timestamps, object_map.unit_metres, &without_region);
   size_t without_odometry = 0;
   const std::vector<std::optional<Pose>> odometry = trackPoses(a, timestamps, &without_odometry);
   const ObserveOptions observe_options = observeOptions(a, policy, lens, console);
@@ -620,7 +624,7 @@ int relocalize(const RelocalizeArgs& a, const Console& console) {
     const RelocalizationResult& r = results[i];
     times.push_back(r.time_ms);
     const Pose* reference = references[i] ? &*references[i] : nullptr;
-    const std::string diagnosis = reference ? diagnose(r, reference_scores[i], *reference) : "";
+    const std::string diagnosis = reference ? diagnose(r, reference_scores[i], *reference, object_map.unit_metres) : "";
     if (reference) ++diagnoses[diagnosis];
     nlohmann::json j = frameReport(frames[i], r, static_cast<int>(observations[i].size()), object_map, reference,
                                    reference_scores[i], diagnosis);

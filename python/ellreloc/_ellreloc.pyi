@@ -272,7 +272,7 @@ class MapObject:
     label: str
     ellipsoid: Ellipsoid
     category_counts: dict[int, float]
-    def problem(self) -> str: """Why relocalization cannot use the object, or '' when it can."""
+    def problem(self, unit_metres: float = ...) -> str: """Why relocalization cannot use the object, or '' when it can (unit_metres: its map's)."""
 
 
 class MapQuality:
@@ -375,6 +375,7 @@ class ObjectMap:
     objects: list[MapObject]
     points: numpy.ndarray
     camera_envelope: Optional[ellreloc::CameraEnvelope]
+    unit_metres: float
     def __len__(self) -> int: ...
 
 
@@ -809,7 +810,7 @@ def observe_frame(frame: DetectionFrame | Sequence[Detection], camera: Intrinsic
 
 def p3p(bearings: ArrayLike, points: ArrayLike) -> list[Pose]: """World->camera poses (up to four) that see the world points (rows of a 3x3 array) along the bearings (rows; normalised here). Degenerate input gives fewer or none."""
 
-def pose_error(estimate: Pose, truth: Pose) -> PoseError: """Distance between the camera centres (cm) and angle between the rotations (deg)."""
+def pose_error(estimate: Pose, truth: Pose, unit_metres: float = ...) -> PoseError: """Distance between the camera centres (cm; unit_metres: metres per unit of the poses) and angle between the rotations (deg)."""
 
 def project(ellipsoid: Ellipsoid, camera: Intrinsics, pose: Pose) -> Optional[Ellipse]: """The image ellipse of an ellipsoid seen from a world->camera pose (P Q* P^T); None when the camera is inside it, it is behind the camera or it crosses the principal plane."""
 

@@ -360,8 +360,9 @@ void bindEvaluation(py::module_& m) {
       .def("__repr__", [](const PoseError& e) {
         return format("PoseError(position_cm=%.4g, rotation_deg=%.4g)", e.position_cm, e.rotation_deg);
       });
-  m.def("pose_error", &poseError, py::arg("estimate"), py::arg("truth"),
-        "Distance between the camera centres (cm) and angle between the rotations (deg).");
+  m.def("pose_error", &poseError, py::arg("estimate"), py::arg("truth"), py::arg("unit_metres") = 1.0,
+        "Distance between the camera centres (cm; unit_metres: metres per unit of the poses) and angle between the "
+        "rotations (deg).");
   py::class_<RelocalizationSummary>(
       m, "Summary", "A row of the paper's Table I: every query frame counts, medians over valid frames.")
       .def_readonly("frames", &RelocalizationSummary::frames)

@@ -221,7 +221,8 @@ void bindObservationAndMap(py::module_& m) {
       .def_readwrite("ellipsoid", &MapObject::ellipsoid)
       .def_readwrite("category_counts", &MapObject::category_counts,
                      "How often mapping saw each category for this object (empty: `category` only).")
-      .def("problem", &mapObjectProblem, "Why relocalization cannot use the object, or '' when it can.")
+      .def("problem", &mapObjectProblem, py::arg("unit_metres") = 1.0,
+           "Why relocalization cannot use the object, or '' when it can (unit_metres: its map's).")
       .def("__repr__", [](const MapObject& o) {
         return "MapObject(id=" + std::to_string(o.id) + ", category=" + std::to_string(o.category) + ", " +
                std::string(py::repr(py::cast(o.ellipsoid))) + ")";
@@ -244,6 +245,14 @@ void bindObservationAndMap(py::module_& m) {
       .def_readwrite("camera_envelope", &ObjectMap::camera_envelope,
                      "Where the map's keyframes were taken (a CameraEnvelope; maps built by a Mapper have one), or "
                      "None. The relocalizer keeps the camera within it unless told otherwise.")
+      .def_property(
+          "unit_metres", [](const ObjectMap& map) { return map.unit_metres; },
+          [](ObjectMap& map, double unit) {
+            if (!validUnitMetres(unit)) throw py::value_error("unit_metres: expected a length of 1e-6 to 1e6 metres");
+            map.unit_metres = unit;
+          },
+          "Metres per unit of the map's coordinates: 1 for a metric map; a monocular system's map (MapperOptions."
+          "unit_metres) is in its own unit.")
       .def("__len__", [](const ObjectMap& map) { return map.objects.size(); })
       .def("__repr__", [](const ObjectMap& map) {
         return "ObjectMap(" + std::to_string(map.objects.size()) + " objects, " + std::to_string(map.points.size()) +

@@ -234,20 +234,27 @@ def test_the_objects_tell_a_monocular_map_its_unit(data_dir):
     keyframes = [(truth[k].pose, f.detections) for f in E.read_detections(d / "detections.json")[:800:2]
                  if (k := index.nearest(f.timestamp)) is not None]
 
-    def estimate(unit_of_poses, unit_metres):
+    def mapper_in(unit_of_poses, unit_metres):
         options = E.MapperOptions()
         options.unit_metres = unit_metres
         mapper = E.Mapper(camera, options, mode="boxes")
         for pose, detections in keyframes:
             mapper.add_keyframe(E.Pose(pose.R_cw, pose.t_cw / unit_of_poses), detections)
         mapper.finish()
-        return mapper.estimated_unit_metres()
+        return mapper
 
-    first = estimate(2.5, 1.0)
+    first = mapper_in(2.5, 1.0).estimated_unit_metres()
     assert first == pytest.approx(2.5, rel=0.15)
-    assert estimate(2.5, first) == pytest.approx(2.5, rel=0.15)
-    assert estimate(1.0, 1.0) == pytest.approx(1.0, rel=0.15)
+    second = mapper_in(2.5, first)
+    assert second.estimated_unit_metres() == pytest.approx(2.5, rel=0.15)
+    assert mapper_in(1.0, 1.0).estimated_unit_metres() == pytest.approx(1.0, rel=0.15)
     assert E.Mapper(camera, mode="boxes").estimated_unit_metres() is None  # no object yet
+    # The map carries its unit: errors in it are told in metres.
+    assert second.map().unit_metres == first
+    a, b = E.Pose(np.eye(3), np.zeros(3)), E.Pose(np.eye(3), np.array([0.0, 0.0, 0.1]))
+    assert E.pose_error(a, b, unit_metres=first).position_cm == pytest.approx(10.0 * first)
+    with pytest.raises(ValueError, match="unit_metres"):
+        second.map().unit_metres = 0.0
 
 
 def test_a_mapped_map_keeps_the_relocalizer_where_it_was_made(data_dir, tmp_path):

@@ -71,7 +71,7 @@ CameraEnvelope parseEnvelope(const json& e, const Where& where) {
 /// Keeps `object` or, when unusable, leaves it out with a warning naming it.
 void keepIfUsable(MapObject object, const std::string& problem, const std::string& source, ObjectMap* map,
                   std::vector<std::string>* warnings) {
-  const std::string why = problem.empty() ? mapObjectProblem(object) : problem;
+  const std::string why = problem.empty() ? mapObjectProblem(object, map->unit_metres) : problem;
   if (why.empty()) {
     map->objects.push_back(std::move(object));
     return;
@@ -100,6 +100,10 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source, std::
   const json& objects = detail::member(j, "objects", top);
   if (!objects.is_array()) top["objects"].fail("expected an array");
   ObjectMap map;
+  if (j.contains("unit_metres")) {  // before the objects, whose semi-axes are checked in metres
+    map.unit_metres = detail::finiteNumber(j["unit_metres"], top["unit_metres"]);
+    if (!validUnitMetres(map.unit_metres)) top["unit_metres"].fail("expected a length of 1e-6 to 1e6 metres");
+  }
   std::vector<std::string> left_out;
   for (size_t i = 0; i < objects.size(); ++i) {
     const Where where = top["objects"][i];
@@ -203,7 +207,9 @@ void writeMap(const std::string& path, const ObjectMap& map) {
     }
     objects.push_back(std::move(obj));
   }
+  if (!validUnitMetres(map.unit_metres)) throw Error(path + ": the map's unit_metres is not a length of 1e-6 to 1e6 m");
   json j = {{"ellreloc_map", 1}, {"objects", std::move(objects)}};
+  if (map.unit_metres != 1.0) j["unit_metres"] = map.unit_metres;  // a metric map's file stays as it was
   if (!map.points.empty()) {
     json points = json::array();
     for (const auto& p : map.points) points.push_back({p(0), p(1), p(2)});

@@ -632,6 +632,7 @@ ObjectMap Mapper::map() const {
   const std::optional<Eigen::Vector3d> up =
       options_.mode == MappingMode::Voxel ? std::optional<Eigen::Vector3d>(upLocked()) : options_.boxes.up;
   out.camera_envelope = CameraEnvelope::fromKeyframes(keyframe_poses_, up, 1.0 / options_.unit_metres, 30.0);
+  out.unit_metres = options_.unit_metres;
   return out;
 }
 

@@ -155,7 +155,7 @@ ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, Relocal
     }
   }
   for (const MapObject& o : map_.objects)
-    if (const std::string problem = mapObjectProblem(o); !problem.empty())
+    if (const std::string problem = mapObjectProblem(o, map_.unit_metres); !problem.empty())
       left_out_.push_back("object " + std::to_string(o.id) + ": " + problem);
 }
 
@@ -304,7 +304,7 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
   // no triplet explains three.
   PoseScorer scorer(observations, candidates, map_, K_, options_.scoring);
   const PoseGate gate = frameGate(gravity, region, options_);
-  HypothesisPool pool(options_.refinement.top_k);
+  HypothesisPool pool(options_.refinement.top_k, map_.unit_metres);
   const HypothesisEstimator estimator(observations, candidates, map_, K_, options_, gate, scorer, &pool);
   SearchOutcome search;
   const FrameBudget budget = frameBudget(options_.search, map_.objects.size(), usable, start);

@@ -133,6 +133,7 @@ void TrackRelocalizer::join(const std::vector<Observation>& observations, const 
 
 std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses(const Carrying& carrying) const {
   const double scale = carrying.scale();
+  const double unit = relocalizer_.map().unit_metres;
   const Pose newest = scaled(frames_.back()->odometry, scale);
   std::vector<Carried> carried;
   for (int k = size() - 1; k >= carrying.first; --k) {  // newest first: of equal costs, the newest frame's pose wins
@@ -142,7 +143,7 @@ std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses(const Carry
       const Pose pose = back * p.pose;
       if (!pose.isValid()) continue;
       if (std::any_of(carried.begin(), carried.end(),
-                      [&](const Carried& c) { return sameNeighbourhood(c.pose, pose); }))
+                      [&](const Carried& c) { return sameNeighbourhood(c.pose, pose, unit); }))
         continue;
       double cost = 0.0;  // over the frames carried
       for (int j = carrying.first; j < size(); ++j)
@@ -285,7 +286,8 @@ void TrackRelocalizer::report(const std::vector<Observation>& observations, cons
 
   // The other answers: carried poses elsewhere, each away from every cheaper one too.
   result.alternatives.clear();
-  const auto elsewhere = [](const Pose& a, const Pose& b) { return !poseError(a, b).valid(); };
+  const double unit = relocalizer_.map().unit_metres;
+  const auto elsewhere = [unit](const Pose& a, const Pose& b) { return !poseError(a, b, unit).valid(); };
   for (const Carried& c : ranked) {
     if (!elsewhere(c.pose, pose)) continue;
     if (std::any_of(result.alternatives.begin(), result.alternatives.end(),

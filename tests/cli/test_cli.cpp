@@ -244,6 +244,32 @@ TEST(Cli, Fr2DeskKeyframesMappedInAUnitOfTheirOwn) {
   };
   EXPECT_NEAR(objects("auto.json"), objects("metric.json"), 2);
   EXPECT_GE(objects("taken.json"), objects("metric.json") + 5);
+  // The map says its unit, and errors against the trajectory in that unit are told in metres.
+  EXPECT_NEAR(nlohmann::json::parse(readFile(dir.path("auto.json"))).at("unit_metres").get<double>(), unit,
+              0.005 * unit);  // printed to 3 digits
+  EXPECT_FALSE(nlohmann::json::parse(readFile(dir.path("metric.json"))).contains("unit_metres"));
+  const CliRun poses = run("relocalize --camera " + d + "/camera.yaml --map " + dir.path("auto.json") +
+                               " --detections " + d + "/keyframes.detections.json --out " + dir.path("poses.txt"),
+                           dir);
+  ASSERT_EQ(poses.code, 0) << poses.err;
+  const std::string evaluate =
+      "evaluate --groundtruth " + dir.path("trajectory.txt") + " --estimate " + dir.path("poses.txt") + " --per-frame ";
+  ASSERT_EQ(run(evaluate + dir.path("metres.csv") + " --map " + dir.path("auto.json"), dir).code, 0);
+  ASSERT_EQ(run(evaluate + dir.path("units.csv") + " --unit-metres 1", dir).code, 0);
+  std::istringstream metres(readFile(dir.path("metres.csv"))), units(readFile(dir.path("units.csv")));
+  int compared = 0;
+  for (std::string m, u; std::getline(metres, m) && std::getline(units, u);) {
+    const auto position = [](const std::string& row) {  // frame,method,status,position_cm,rotation_deg
+      std::vector<std::string> f;
+      std::istringstream fields(row);
+      for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+      return f.size() == 5 && f[2] != "status" ? std::stod(f[3]) : -1.0;
+    };
+    if (position(m) < 0.0 || position(u) < 0.01) continue;
+    EXPECT_NEAR(position(m) / position(u), unit, 0.01 * unit) << m << " / " << u;
+    ++compared;
+  }
+  EXPECT_GT(compared, 100);
 }
 
 // Wrong poses on real data are ambiguous ones: asking for a margin over the best rival drops

@@ -87,6 +87,35 @@ TEST(MapIo, TheCameraEnvelopeRoundTrips) {
   EXPECT_FALSE(std::ifstream(dir.path("bad.json")).good());
 }
 
+// A map in a unit other than the metre says so (unit_metres), and the bounds on semi-axes are
+// checked in metres: a 0.5 mm semi-axis of a map in units of 4 m is 2 mm, a 3-unit one 12 m.
+TEST(MapIo, TheMapsUnitRoundTripsAndTheBoundsAreInMetres) {
+  test::TempDir dir;
+  ObjectMap map;
+  map.objects.push_back({1, 41, "cup", Ellipsoid({0, 0, 1}, {0.0005, 0.02, 0.03}, Eigen::Matrix3d::Identity())});
+  map.objects.push_back({2, 62, "tv", Ellipsoid({1, 0, 1}, {0.1, 3.0, 0.2}, Eigen::Matrix3d::Identity())});
+  map.unit_metres = 4.0;
+  io::writeMap(dir.path("map.json"), map);
+  EXPECT_EQ(nlohmann::json::parse(io::readTextFile(dir.path("map.json")))["unit_metres"], 4.0);
+  std::vector<std::string> warnings;
+  const ObjectMap back = io::readMap(dir.path("map.json"), &warnings);
+  EXPECT_EQ(back.unit_metres, 4.0);
+  ASSERT_EQ(back.objects.size(), 1u);
+  EXPECT_EQ(back.objects[0].id, 1);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("object 2 left out: semi-axis 3 (12 m) is above 10 m"), std::string::npos) << warnings[0];
+  // A metric map's file has no unit_metres, and reads back as metres.
+  map.unit_metres = 1.0;
+  map.objects.pop_back();
+  map.objects[0].ellipsoid = Ellipsoid({0, 0, 1}, {0.005, 0.02, 0.03}, Eigen::Matrix3d::Identity());
+  io::writeMap(dir.path("metric.json"), map);
+  EXPECT_FALSE(nlohmann::json::parse(io::readTextFile(dir.path("metric.json"))).contains("unit_metres"));
+  EXPECT_EQ(io::readMap(dir.path("metric.json")).unit_metres, 1.0);
+  map.unit_metres = -1.0;  // not a length: not written, no file left
+  EXPECT_THROW(io::writeMap(dir.path("bad.json"), map), Error);
+  EXPECT_FALSE(std::ifstream(dir.path("bad.json")).good());
+}
+
 TEST(MapIo, ReadsOaSlamTextMaps) {
   std::mt19937 rng(42);
   std::ostringstream text;
@@ -133,6 +162,8 @@ TEST(MapIo, MalformedMapsNameTheFileAndField) {
       {"{\"ellreloc_map\": 1}", "objects: missing"},
       {"{\"objects\": {}}", "objects: expected an array"},
       {"{\"ellreloc_map\": 2, \"objects\": []}", "unsupported version"},
+      {"{\"objects\": [" + obj + "], \"unit_metres\": 0}", "unit_metres: expected a length of 1e-6 to 1e6 metres"},
+      {"{\"objects\": [" + obj + "], \"unit_metres\": \"2\"}", "unit_metres"},
       {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})",
        "objects[0].center: expected an array of 3"},
       {R"({"objects": [{"id": 1, "category": 41, "center": [0, 0, 1], "axes": [1,-1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})",

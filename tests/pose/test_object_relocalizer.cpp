@@ -771,6 +771,65 @@ TEST(ObjectRelocalizer, LeavesOutDegenerateMapObjects) {
   }
 }
 
+namespace {
+
+/// `map` in units of `unit` metres: its centres and semi-axes divided by it.
+ObjectMap inUnit(ObjectMap map, double unit) {
+  for (MapObject& o : map.objects)
+    o.ellipsoid = Ellipsoid(o.ellipsoid.center() / unit, o.ellipsoid.axes() / unit, o.ellipsoid.rotation());
+  map.unit_metres = unit;
+  return map;
+}
+
+/// The number of scenes among `scenes` whose result in the map of unit 4 m, its poses taken back
+/// to metres, differs from the metric map's: pose, matches, alternatives or margin.
+int scenesThatDifferInAnotherUnit(const std::vector<Synthetic>& scenes, bool give_the_unit) {
+  const Intrinsics K = test::testIntrinsics();
+  const double unit = 4.0;
+  int differ = 0;
+  for (const Synthetic& s : scenes) {
+    ObjectMap scaled = inUnit(s.map, unit);
+    if (!give_the_unit) scaled.unit_metres = 1.0;
+    const RelocalizationResult metric = ObjectRelocalizer(s.map, K).relocalize(s.observations);
+    const RelocalizationResult other = ObjectRelocalizer(scaled, K).relocalize(s.observations);
+    bool same = metric.status == other.status && metric.inliers.size() == other.inliers.size() &&
+                metric.alternatives.size() == other.alternatives.size() &&
+                (metric.pose.center() - unit * other.pose.center()).norm() < 1e-9 &&
+                (metric.pose.rotation() - other.pose.rotation()).norm() < 1e-9 &&
+                (metric.margin == other.margin || std::abs(metric.margin - other.margin) < 1e-9);
+    for (size_t k = 0; same && k < metric.alternatives.size(); ++k)
+      same = (metric.alternatives[k].pose.center() - unit * other.alternatives[k].pose.center()).norm() < 1e-9;
+    differ += !same;
+  }
+  return differ;
+}
+
+}  // namespace
+
+// A monocular system's map is in a unit of its own. Given the map's unit, the relocalizer finds
+// the same poses in it as in metres (its distances in metres, the 5 cm of near-equal hypotheses
+// and the 30 cm between distinct answers, are converted); without it, the answers it tells
+// apart change.
+TEST(ObjectRelocalizer, AMapInAnotherUnitGivesTheSamePosesInThatUnit) {
+  std::mt19937 rng(41);
+  std::vector<Synthetic> scenes;
+  for (int trial = 0; trial < 8; ++trial) scenes.push_back(makeSceneSeeing(rng, 4, 16, 3, 1.0));
+  EXPECT_EQ(scenesThatDifferInAnotherUnit(scenes, true), 0);
+  EXPECT_GT(scenesThatDifferInAnotherUnit(scenes, false), 0);
+}
+
+// The bounds on semi-axes (1 mm to 10 m) are in metres, whatever the map's unit.
+TEST(ObjectRelocalizer, SemiAxisBoundsAreInMetresInAnyUnit) {
+  MapObject o{1, 0, "", Ellipsoid({0, 0, 0}, {0.0004, 0.02, 0.05}, Eigen::Matrix3d::Identity())};
+  EXPECT_NE(mapObjectProblem(o).find("below 1 mm"), std::string::npos);
+  EXPECT_TRUE(mapObjectUsable(o, 10.0));  // 4 mm in a unit of 10 m
+  const std::string problem = mapObjectProblem(o, 0.5);
+  EXPECT_NE(problem.find("0.0004 (0.0002 m) is below 1 mm"), std::string::npos) << problem;
+  o.ellipsoid = Ellipsoid({0, 0, 0}, {0.2, 1.5, 0.1}, Eigen::Matrix3d::Identity());
+  EXPECT_TRUE(mapObjectUsable(o));
+  EXPECT_NE(mapObjectProblem(o, 10.0).find("(15 m) is above 10 m"), std::string::npos);
+}
+
 // The envelope of the mapping keyframes: heights and tilts widened by the margins; the up
 // direction defaults to the keyframes' mean image-up.
 TEST(CameraEnvelope, FromKeyframesAndAdmits) {

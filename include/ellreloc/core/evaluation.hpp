@@ -22,8 +22,10 @@ struct PoseError {
   bool valid() const { return position_cm < kValidPositionCm && rotation_deg < kValidRotationDeg; }
 };
 
-inline PoseError poseError(const Pose& estimate, const Pose& truth) {
-  return {100.0 * (estimate.center() - truth.center()).norm(), rotationErrorDeg(estimate.rotation(), truth.rotation())};
+/// `unit_metres`: metres per unit of the poses' translations (1 for metric poses).
+inline PoseError poseError(const Pose& estimate, const Pose& truth, double unit_metres = 1.0) {
+  return {100.0 * unit_metres * (estimate.center() - truth.center()).norm(),
+          rotationErrorDeg(estimate.rotation(), truth.rotation())};
 }
 
 /// A row of Table I: every query frame counts; the medians are over the valid frames.

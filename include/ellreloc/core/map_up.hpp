@@ -64,7 +64,7 @@ inline std::optional<MapUp> estimateMapUp(const ObjectMap& map, double min_t = 2
   std::vector<double> heights;
   std::vector<size_t> known;  // the centres of a category with a usual height
   for (const MapObject& o : map.objects) {
-    if (!mapObjectUsable(o)) continue;
+    if (!mapObjectUsable(o, map.unit_metres)) continue;
     const double height = typicalCentreHeight(o.category);
     if (std::isfinite(height)) known.push_back(centres.size());
     centres.push_back(o.ellipsoid.center());

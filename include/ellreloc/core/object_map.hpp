@@ -42,7 +42,14 @@ struct ObjectMap {
   /// Optional: the heights and tilts the map's keyframes were taken at (widened); the
   /// relocalizer keeps the camera within them (RelocalizerOptions::map_envelope).
   std::optional<CameraEnvelope> camera_envelope;
+  /// Metres per unit of the map's coordinates: 1 for a metric map. A monocular SLAM system's
+  /// map is in a unit of its own (MapperOptions::unit_metres); the bounds on semi-axes and the
+  /// relocalizer's distances, which are in metres, are converted with it.
+  double unit_metres = 1.0;
 };
+
+/// The map's unit is a length (finite, positive; 1e-6 to 1e6 metres).
+inline bool validUnitMetres(double unit_metres) { return unit_metres >= 1e-6 && unit_metres <= 1e6; }
 
 /// Semi-axes outside [kMinSemiAxis, kMaxSemiAxis] metres make an object unusable: a
 /// sub-millimetre axis is a degenerate fit (a disc or a needle), above 10 m no indoor object.
@@ -51,26 +58,30 @@ constexpr double kMaxSemiAxis = 10.0;
 
 /// Why `object` cannot be used for relocalization, in a few words, or "" when it can: a
 /// non-finite centre or rotation, a semi-axis non-finite or outside [kMinSemiAxis,
-/// kMaxSemiAxis], or a rotation that is not one.
-inline std::string mapObjectProblem(const MapObject& object) {
+/// kMaxSemiAxis] metres (`unit_metres`: metres per unit of the map), or a rotation that is
+/// not one.
+inline std::string mapObjectProblem(const MapObject& object, double unit_metres = 1.0) {
   const Ellipsoid& e = object.ellipsoid;
   if (!e.center().allFinite()) return "centre is not finite";
   if (!e.axes().allFinite()) return "a semi-axis is not finite";
-  char text[64];
-  if (!(e.axes().minCoeff() >= kMinSemiAxis)) {
-    std::snprintf(text, sizeof text, "semi-axis %.3g m is below 1 mm", e.axes().minCoeff());
-    return text;
-  }
-  if (!(e.axes().maxCoeff() <= kMaxSemiAxis)) {
-    std::snprintf(text, sizeof text, "semi-axis %.3g m is above 10 m", e.axes().maxCoeff());
-    return text;
-  }
+  char text[96];
+  const auto outside = [&](double axis, const char* bound) {
+    if (unit_metres == 1.0)
+      std::snprintf(text, sizeof text, "semi-axis %.3g m is %s", axis, bound);
+    else
+      std::snprintf(text, sizeof text, "semi-axis %.3g (%.3g m) is %s", axis, axis * unit_metres, bound);
+    return std::string(text);
+  };
+  if (!(e.axes().minCoeff() * unit_metres >= kMinSemiAxis)) return outside(e.axes().minCoeff(), "below 1 mm");
+  if (!(e.axes().maxCoeff() * unit_metres <= kMaxSemiAxis)) return outside(e.axes().maxCoeff(), "above 10 m");
   if (!isRotation(e.rotation())) return "rotation is not a rotation matrix";
   return "";
 }
 
 /// The object can be used for relocalization (mapObjectProblem finds nothing; the text is
 /// only built for an unusable object).
-inline bool mapObjectUsable(const MapObject& object) { return mapObjectProblem(object).empty(); }
+inline bool mapObjectUsable(const MapObject& object, double unit_metres = 1.0) {
+  return mapObjectProblem(object, unit_metres).empty();
+}
 
 }  // namespace ellreloc

@@ -14,7 +14,8 @@ namespace ellreloc::io {
 /// format. Rotations within 1e-3 of orthonormal (rounded files) are projected onto the nearest
 /// rotation. Throws ellreloc::Error naming the file and the field or line on malformed input.
 /// A well-formed object that cannot be used (mapObjectProblem: a zero, negative, non-finite,
-/// sub-millimetre or > 10 m semi-axis, a singular dual quadric) is left out of the map, with
+/// sub-millimetre or > 10 m semi-axis, in metres by the map's `unit_metres` when the JSON gives
+/// one, else 1; a singular dual quadric) is left out of the map, with
 /// one line per object in `warnings` ("FILE: object ID left out: WHY"); a map left without
 /// any object is an Error.
 ObjectMap readMap(const std::string& path, std::vector<std::string>* warnings = nullptr);
@@ -27,7 +28,8 @@ ObjectMap parseMapJson(const std::string& text, const std::string& source,
 ObjectMap parseOaSlamMap(const std::string& text, const std::string& source,
                          std::vector<std::string>* warnings = nullptr);
 
-/// Writes the JSON map (centre/axes/rotation form), atomically.
+/// Writes the JSON map (centre/axes/rotation form), atomically; `unit_metres` only when it is
+/// not 1.
 void writeMap(const std::string& path, const ObjectMap& map);
 
 }  // namespace ellreloc::io

@@ -83,7 +83,7 @@ Candidates collectCandidates(const std::vector<Observation>& observations, const
   std::vector<long> count(observations.size(), 0);
   std::vector<size_t> order;
   std::vector<char> object_usable(map.objects.size());  // checked once per object, not per pair
-  for (size_t j = 0; j < map.objects.size(); ++j) object_usable[j] = mapObjectUsable(map.objects[j]);
+  for (size_t j = 0; j < map.objects.size(); ++j) object_usable[j] = mapObjectUsable(map.objects[j], map.unit_metres);
   for (size_t i = 0; i < observations.size(); ++i) {
     const Observation& o = observations[i];
     if (!o.ellipse.isValid() || !o.box.isValid() || !std::isfinite(o.score)) {

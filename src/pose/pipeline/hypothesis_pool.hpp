@@ -10,9 +10,10 @@
 
 namespace ellreloc::pipeline {
 
-/// Two poses count as one hypothesis: centres within 5 cm, rotations within 3 degrees.
-inline bool sameNeighbourhood(const Pose& a, const Pose& b) {
-  return (a.center() - b.center()).norm() < 0.05 && rotationErrorDeg(a.rotation(), b.rotation()) < 3.0;
+/// Two poses count as one hypothesis: centres within 5 cm, rotations within 3 degrees
+/// (`unit_metres`: metres per unit of the map, ObjectMap::unit_metres).
+inline bool sameNeighbourhood(const Pose& a, const Pose& b, double unit_metres) {
+  return (a.center() - b.center()).norm() < 0.05 / unit_metres && rotationErrorDeg(a.rotation(), b.rotation()) < 3.0;
 }
 
 /// Keeps the `capacity` lowest-cost poses, at most one per neighbourhood (sameNeighbourhood):
@@ -20,12 +21,14 @@ inline bool sameNeighbourhood(const Pose& a, const Pose& b) {
 /// would crowd out the alternatives.
 class HypothesisPool {
  public:
-  explicit HypothesisPool(int capacity) : capacity_(static_cast<size_t>(std::max(1, capacity))) {}
+  /// `unit_metres`: metres per unit of the map (ObjectMap::unit_metres).
+  HypothesisPool(int capacity, double unit_metres)
+      : capacity_(static_cast<size_t>(std::max(1, capacity))), unit_metres_(unit_metres) {}
 
   void offer(const Pose& pose, double cost) {
     if (entries_.size() == capacity_ && cost >= entries_.back().cost) return;
     for (ScoredPose& h : entries_) {
-      if (sameNeighbourhood(h.pose, pose)) {
+      if (sameNeighbourhood(h.pose, pose, unit_metres_)) {
         if (cost < h.cost) h = {pose, cost};
         sortByCost();
         return;
@@ -52,6 +55,7 @@ class HypothesisPool {
     if (entries_.size() >= capacity_) admission_.store(entries_[capacity_ - 1].cost, std::memory_order_relaxed);
   }
   size_t capacity_;
+  double unit_metres_;
   std::vector<ScoredPose> entries_;
   std::atomic<double> admission_{std::numeric_limits<double>::infinity()};
 };

@@ -105,7 +105,8 @@ ChosenPose refineHypotheses(const HypothesisPool& pool, const Pose& search_best,
   for (const ChosenPose& candidate : refined) by_cost.push_back(&candidate);
   std::stable_sort(by_cost.begin(), by_cost.end(),
                    [](const ChosenPose* a, const ChosenPose* b) { return a->cost < b->cost; });
-  const auto elsewhere = [](const Pose& a, const Pose& b) { return !poseError(a, b).valid(); };  // another answer
+  const double unit = context.map.unit_metres;
+  const auto elsewhere = [unit](const Pose& a, const Pose& b) { return !poseError(a, b, unit).valid(); };
   for (const ChosenPose* candidate : by_cost) {
     if (!elsewhere(candidate->pose, best.pose)) continue;
     const bool seen = std::any_of(best.alternatives.begin(), best.alternatives.end(),
