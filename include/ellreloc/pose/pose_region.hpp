@@ -16,8 +16,9 @@ namespace ellreloc {
 
 struct PoseRegion {
   Pose pose;                        ///< world->camera: the last pose the host tracked
-  double radius_m =
-      1.0;  ///< the camera centre lies within this distance of pose.center() (map units: metres in a metric map)
+  /// The camera centre lies within this distance of pose.center(), in the map's units (metres in
+  /// a metric map).
+  double radius_m = 1.0;
   double max_rotation_deg = 180.0;  ///< and its rotation within this angle of pose's (180: any)
 
   /// A valid pose, a positive finite radius and an angle in (0, 180].
