@@ -182,7 +182,7 @@ std::vector<ScoredPose> sweepAndRefine(const Intrinsics& K, const std::vector<El
   for (int k : minima) {
     const RefinementResult r = refinePose(K, pose[k], matches, {}, opt.refiner, gravity);
     const bool duplicate = std::any_of(out.begin(), out.end(), [&](const ScoredPose& p) {
-      return (p.pose.center() - r.pose.center()).norm() < 0.01 &&
+      return (p.pose.center() - r.pose.center()).norm() < 0.01 / opt.unit_metres &&
              rotationErrorDeg(p.pose.rotation(), r.pose.rotation()) < 0.5;
     });
     if (!duplicate && r.pose.isValid() && bounds.admits(r.pose))
@@ -196,14 +196,18 @@ bool usable(const Intrinsics& K, const EllipseMatch& m) {
   return K.isValid() && m.observed.isValid() && m.ellipsoid.isValid();
 }
 
+bool validUnit(const FewObjectOptions& options) {
+  return options.unit_metres > 0.0 && std::isfinite(options.unit_metres);
+}
+
 }  // namespace
 
 std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMatch& a, const EllipseMatch& b,
                                             const std::optional<GravityPrior>& gravity, const FewObjectOptions& options,
                                             const std::optional<CameraEnvelope>& envelope,
                                             const std::optional<PoseRegion>& region) {
-  if (!usable(K, a) || !usable(K, b) || (gravity && !gravity->isValid()) || (envelope && !envelope->isValid()) ||
-      (region && !region->isValid()))
+  if (!usable(K, a) || !usable(K, b) || !validUnit(options) || (gravity && !gravity->isValid()) ||
+      (envelope && !envelope->isValid()) || (region && !region->isValid()))
     return {};
   SweepBounds bounds;
   if (envelope) bounds.envelope = envelope->prepared();
@@ -275,7 +279,7 @@ std::vector<ScoredPose> posesFromTwoObjects(const Intrinsics& K, const EllipseMa
 
 std::vector<ScoredPose> posesFromOneObject(const Intrinsics& K, const EllipseMatch& a, const GravityPrior& gravity,
                                            const FewObjectOptions& options) {
-  if (!usable(K, a) || !gravity.isValid()) return {};
+  if (!usable(K, a) || !validUnit(options) || !gravity.isValid()) return {};
   // Every rotation with R up_map = up_camera: align, then turn about the map's up (the yaw).
   const Eigen::Vector3d up = gravity.up_in_map.normalized();
   const Eigen::Matrix3d align =

@@ -144,6 +144,7 @@ RelocalizationResult inGivenOrder(RelocalizationResult result, const std::vector
 
 ObjectRelocalizer::ObjectRelocalizer(ObjectMap map, const Intrinsics& K, RelocalizerOptions options)
     : map_(std::move(map)), K_(K), options_(std::move(options)) {
+  options_.few_objects.solver.unit_metres = map_.unit_metres;
   if (!options_.envelope && options_.map_envelope) {
     if (map_.camera_envelope && map_.camera_envelope->isValid()) {
       options_.envelope = map_.camera_envelope;

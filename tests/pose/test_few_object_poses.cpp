@@ -266,6 +266,11 @@ TEST(FewObjectPoses, BadInputGivesNoPose) {
   EXPECT_TRUE(posesFromTwoObjects(K, nan_ellipse, m[1]).empty());
   EXPECT_TRUE(posesFromTwoObjects(K, m[0], m[0]).empty());  // one ellipsoid centre twice
   EXPECT_TRUE(posesFromTwoObjects(Intrinsics(), m[0], m[1]).empty());
+  EXPECT_FALSE(posesFromTwoObjects(K, m[0], m[1]).empty());
+  FewObjectOptions no_unit;
+  no_unit.unit_metres = 0.0;
+  EXPECT_TRUE(posesFromTwoObjects(K, m[0], m[1], std::nullopt, no_unit).empty());
+  EXPECT_TRUE(posesFromOneObject(K, m[0], GravityPrior::atPose(truth), no_unit).empty());
   GravityPrior zero = GravityPrior::atPose(truth);
   zero.up_in_map.setZero();
   EXPECT_TRUE(posesFromOneObject(K, m[0], zero).empty());

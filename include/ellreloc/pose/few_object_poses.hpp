@@ -39,6 +39,10 @@ struct FewObjectOptions {
   /// the best rotation found at that angle is not placed: the same poses, a few times faster.
   bool skip_tilted = true;
   RefinerOptions refiner;
+  /// Metres per unit of the ellipsoids' coordinates: refined poses within 1 cm and half a degree
+  /// of each other are one. The relocalizer sets its map's (ObjectMap::unit_metres). A unit that
+  /// is not a positive length gives no pose.
+  double unit_metres = 1.0;
 };
 
 /// Poses from two ellipse-ellipsoid correspondences (distinct ellipsoid centres), optionally
