@@ -558,7 +558,7 @@ void printTrackSummary(const RelocalizeArgs& a, const std::vector<std::optional<
         "no scale found for %s: no two frames of a track had poses of their own that turned and moved as it does\n",
         a.track.c_str());
   else
-    std::printf("scale of %s: median %.4g map metres per unit over the %zu tracked frame(s) that gave one\n",
+    std::printf("scale of %s: median %.4g map units per odometry unit over the %zu tracked frame(s) that gave one\n",
                 a.track.c_str(), median(scales), scales.size());
 }
 

@@ -512,8 +512,8 @@ void bindTrack(py::module_& m) {
       .def_readonly("found_by", &TrackResult::found_by,
                     "Whose search found the pose: 0 this frame, 1 the one before, ...; -1 when none did.")
       .def_readonly("scale", &TrackResult::scale,
-                    "Map metres per odometry unit the poses were carried with: 1 with metric odometry, else the "
-                    "estimate (0 while there is none).")
+                    "Map units per odometry unit the poses were carried with (map metres in a metric map): 1 / the "
+                    "map's unit_metres with metric odometry, else the estimate (0 while there is none).")
       .def("__repr__", [](const TrackResult& t) {
         return std::string("TrackResult(") + py::str(py::cast(t.result.status)).cast<std::string>() + ", " +
                std::to_string(t.frames) + " frames, found by " + std::to_string(t.found_by) + ")";

@@ -143,7 +143,7 @@ def test_a_track_finds_the_scale_of_a_monocular_odometry(fr2, data_dir, cli, tmp
                               str(tmp_path / "odometry.txt"), "--track-frames", "5", "--track-scale-unknown", "--out",
                               str(tmp_path / "cli.txt"), "--report", str(tmp_path / "report.json")],
                              check=True, capture_output=True, text=True).stdout
-    said = re.search(r"median ([0-9.]+) map metres per unit over the (\d+) tracked frame", printed)
+    said = re.search(r"median ([0-9.]+) map units per odometry unit over the (\d+) tracked frame", printed)
     assert said and abs(float(said.group(1)) / 0.37 - 1) < 0.05, printed
     relocalizer = E.ObjectRelocalizer(map_, camera)
     track = E.TrackRelocalizer(relocalizer, max_frames=5, metric_odometry=False)

@@ -28,11 +28,11 @@ constexpr int kScaleSearchSteps = 4;
 /// Scales beyond e^+-200 (steps of 2000) are no unit of any odometry: a proposal there is clamped.
 constexpr int kMaxScaleStep = 2000;
 
-/// An odometry pose with its translation in map metres: the camera centre scaled about the
+/// An odometry pose with its translation in map units: the camera centre scaled about the
 /// odometry's origin.
 Pose scaled(const Pose& odometry, double scale) { return Pose(odometry.rotation(), scale * odometry.translation()); }
 
-/// Map metres per odometry unit at a scale step.
+/// Map units per odometry unit at a scale step, relative to the step 0's.
 double scaleAt(int scale_step) { return std::exp(kScaleStep * scale_step); }
 
 /// The pose of the frame at odometry pose `on` given the pose `pose` of the frame at odometry pose
@@ -66,13 +66,14 @@ struct TrackRelocalizer::Frame {
   };
   std::vector<Found> found;
 
-  /// The cost of `by`'s pose `p` on this frame, carried at `scale_step`.
-  double costOf(const Found& p, const Frame& by, int scale_step) const {
+  /// The cost of `by`'s pose `p` on this frame, carried as `carrying` says (its base is the
+  /// track's: the step tells its scales apart).
+  double costOf(const Found& p, const Frame& by, const Carrying& carrying) const {
     const std::uint64_t key =
-        (static_cast<std::uint64_t>(serial) << 20) ^ static_cast<std::uint64_t>(scale_step + (1 << 19));
+        (static_cast<std::uint64_t>(serial) << 20) ^ static_cast<std::uint64_t>(carrying.scale_step + (1 << 19));
     const auto known = p.costs.find(key);
     if (known != p.costs.end()) return known->second;
-    const Pose at = carriedPose(odometry, by.odometry, scaleAt(scale_step), p.pose);
+    const Pose at = carriedPose(odometry, by.odometry, carrying.scale(), p.pose);
     // An absurd scale of an absurd odometry can leave no finite pose: it explains nothing.
     const double cost = at.isValid() ? scorer->cost(at, kRankingIoUVertices) : std::numeric_limits<double>::infinity();
     p.costs.emplace(key, cost);
@@ -80,7 +81,7 @@ struct TrackRelocalizer::Frame {
   }
 };
 
-double TrackRelocalizer::Carrying::scale() const { return scaleAt(scale_step); }
+double TrackRelocalizer::Carrying::scale() const { return base * scaleAt(scale_step); }
 
 TrackRelocalizer::TrackRelocalizer(const ObjectRelocalizer& relocalizer, TrackOptions options)
     : relocalizer_(relocalizer), options_(options) {}
@@ -146,8 +147,7 @@ std::vector<TrackRelocalizer::Carried> TrackRelocalizer::rankedPoses(const Carry
                       [&](const Carried& c) { return sameNeighbourhood(c.pose, pose, unit); }))
         continue;
       double cost = 0.0;  // over the frames carried
-      for (int j = carrying.first; j < size(); ++j)
-        cost += frames_[static_cast<size_t>(j)]->costOf(p, f, carrying.scale_step);
+      for (int j = carrying.first; j < size(); ++j) cost += frames_[static_cast<size_t>(j)]->costOf(p, f, carrying);
       carried.push_back({pose, size() - 1 - k, cost});
     }
   }
@@ -207,8 +207,9 @@ double TrackRelocalizer::proposedScale() const {
 
 TrackRelocalizer::Carrying TrackRelocalizer::chooseCarrying(std::vector<Carried>* ranked) {
   if (options_.metric_odometry) {
-    *ranked = rankedPoses(Carrying{});
-    return Carrying{};
+    const Carrying metric{0, 0, true, 1.0 / relocalizer_.map().unit_metres};
+    *ranked = rankedPoses(metric);
+    return metric;
   }
   const double proposed = proposedScale();
   const std::optional<int> centre =

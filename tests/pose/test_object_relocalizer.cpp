@@ -13,6 +13,7 @@
 #include "ellreloc/sim/map_observations.hpp"
 #include "ellreloc/sim/noise.hpp"
 #include "ellreloc/sim/render.hpp"
+#include "fixtures/map_in_unit.hpp"
 #include "fixtures/random_geometry.hpp"
 
 using namespace ellreloc;
@@ -773,14 +774,6 @@ TEST(ObjectRelocalizer, LeavesOutDegenerateMapObjects) {
 
 namespace {
 
-/// `map` in units of `unit` metres: its centres and semi-axes divided by it.
-ObjectMap inUnit(ObjectMap map, double unit) {
-  for (MapObject& o : map.objects)
-    o.ellipsoid = Ellipsoid(o.ellipsoid.center() / unit, o.ellipsoid.axes() / unit, o.ellipsoid.rotation());
-  map.unit_metres = unit;
-  return map;
-}
-
 /// The number of scenes among `scenes` whose result in the map of unit 4 m, its poses taken back
 /// to metres, differs from the metric map's: pose, matches, alternatives or margin.
 int scenesThatDifferInAnotherUnit(const std::vector<Synthetic>& scenes, bool give_the_unit,
@@ -789,7 +782,7 @@ int scenesThatDifferInAnotherUnit(const std::vector<Synthetic>& scenes, bool giv
   const double unit = 4.0;
   int differ = 0;
   for (const Synthetic& s : scenes) {
-    ObjectMap scaled = inUnit(s.map, unit);
+    ObjectMap scaled = test::mapInUnit(s.map, unit);
     if (!give_the_unit) scaled.unit_metres = 1.0;
     const RelocalizationResult metric = ObjectRelocalizer(s.map, K, options).relocalize(s.observations);
     const RelocalizationResult other = ObjectRelocalizer(scaled, K, options).relocalize(s.observations);

@@ -9,6 +9,7 @@
 #include "ellreloc/sim/map_observations.hpp"
 #include "ellreloc/sim/noise.hpp"
 #include "ellreloc/sim/render.hpp"
+#include "fixtures/map_in_unit.hpp"
 #include "fixtures/random_geometry.hpp"
 #include "fixtures/twin_desks.hpp"
 
@@ -93,6 +94,33 @@ TEST(TrackRelocalizer, AnEarlierViewOfAUniqueObjectTellsTheLookAlikeDesksApart) 
     for (const ObjectCorrespondence& m : r.result.inliers) EXPECT_EQ(map.objects[m.object].id, ids_b[m.observation]);
     // The plant view, carried to the desk view, rules the twin out by what it leaves unexplained.
     EXPECT_GT(r.result.margin, 0.5);
+  }
+}
+
+// A monocular system's map is in a unit of its own, and the host's odometry may be metric
+// (visual-inertial): the track carries the frames' poses in the map's units per metre, and finds
+// the pose the metric map gives, in the map's unit.
+TEST(TrackRelocalizer, MetricOdometryAgainstAMapInAnotherUnit) {
+  const double unit = 4.0;
+  const ObjectMap map = test::mapInUnit(desksAndAPlant(), unit);
+  const ObjectRelocalizer relocalizer(map, test::testIntrinsics());
+  std::mt19937 rng(5);
+  int trials = 0;
+  while (trials < 6) {
+    std::vector<int> ids_a, ids_b;
+    const Pose truth_a = plantView(rng), truth_b = deskView(rng);
+    const std::vector<Observation> a = observe(desksAndAPlant(), truth_a, rng, &ids_a);
+    const std::vector<Observation> b = observe(desksAndAPlant(), truth_b, rng, &ids_b);
+    if (!holds(ids_a, kPlantId) || a.size() < 4 || b.size() < 4 || holds(ids_b, kPlantId)) continue;
+    ++trials;
+    const Pose odometry_to_world = arbitraryMotion(rng);  // metres
+    TrackRelocalizer track(relocalizer);
+    track.add(a, odometryOf(truth_a, odometry_to_world));
+    const TrackResult r = track.add(b, odometryOf(truth_b, odometry_to_world));
+    ASSERT_EQ(r.result.status, RelocalizationStatus::Success) << r.result.reason;
+    EXPECT_EQ(r.scale, 1.0 / unit);
+    EXPECT_LT(poseError(r.result.pose, test::poseInUnit(truth_b, unit), unit).position_cm, 1.0);
+    EXPECT_GT(r.result.margin, 0.5);  // the plant view, carried in the map's unit, rules the twin out
   }
 }
 

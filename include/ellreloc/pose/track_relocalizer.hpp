@@ -40,7 +40,7 @@ struct TrackOptions {
   double min_margin = 0.5;
   /// The odometry is metric (visual-inertial, stereo or RGB-D odometry, wheels). A monocular
   /// host's odometry (the new map a monocular SLAM system starts after a loss) has a scale of its
-  /// own, unknown and drifting: false, and the track estimates the map's metres per odometry
+  /// own, unknown and drifting: false, and the track estimates the map's units per odometry
   /// unit at each frame. Pairs of frames whose own poses turn and move as the odometry does
   /// propose a scale; the scale, within a factor 1.5 of theirs, at which the track's best pose
   /// costs least is taken (TrackResult::scale). Until a first proposal, the newest frame's own
@@ -64,8 +64,9 @@ struct TrackResult {
   int frames = 0;               ///< frames whose observations ranked the poses, this one included
   int candidates = 0;           ///< distinct poses ranked
   int found_by = -1;            ///< whose search found the pose: 0 this frame, 1 the one before, ...
-  /// Map metres per odometry unit with which the poses were carried: 1 with metric odometry, the
-  /// estimate otherwise (0 while there is none).
+  /// Map units per odometry unit with which the poses were carried (map metres when the map is
+  /// metric): 1 / the map's unit_metres with metric odometry, the estimate otherwise (0 while
+  /// there is none).
   double scale = 1.0;
 };
 
@@ -99,12 +100,15 @@ class TrackRelocalizer {
     int found_by;  // 0 the newest frame, 1 the one before, ...
     double cost;   // over the frames ranked
   };
-  /// How the poses are carried: the odometry's translations times exp(kScaleStep * scale_step),
-  /// read from the track's frames from `first` (an index into frames_) to the newest.
+  /// How the poses are carried: the odometry's translations times base * exp(kScaleStep *
+  /// scale_step), read from the track's frames from `first` (an index into frames_) to the
+  /// newest. `base`: map units per odometry unit at step 0, 1 / the map's unit_metres for metric
+  /// odometry, else 1.
   struct Carrying {
     int scale_step = 0;
     int first = 0;
     bool known = true;  // false: no scale yet, the newest frame alone
+    double base = 1.0;
     double scale() const;
   };
   /// The cost of the newest frame's pose `pose` over the frames carried (each at the pose the
@@ -120,11 +124,11 @@ class TrackRelocalizer {
   /// Every carried frame's poses, carried to the newest frame, each once (5 cm, 3 degrees),
   /// cheapest first.
   std::vector<Carried> rankedPoses(const Carrying& carrying) const;
-  /// Metric odometry: scale 1 over the whole track. Otherwise the scale step, near the scale the
+  /// Metric odometry: the map's units per metre over the whole track. Otherwise the scale step, near the scale the
   /// frames' poses propose (or the last one chosen), whose best pose costs least; without
   /// either, the newest frame alone. Fills `ranked` with that carrying's poses.
   Carrying chooseCarrying(std::vector<Carried>* ranked);
-  /// The scale (map metres per odometry unit) pairs of the track's frames propose, or 0.
+  /// The scale (map units per odometry unit) pairs of the track's frames propose, or 0.
   double proposedScale() const;
   /// Fills the result at the chosen pose: this frame's matches, the track's cost and evidence,
   /// the other answers and the status.
