@@ -58,9 +58,10 @@ std::vector<PointMatch> pointMatches(const std::vector<Keypoint>& keypoints, con
 }
 
 /// Why the input cannot be relocalized at all, or empty.
-std::string invalidInput(const Intrinsics& K, const std::optional<GravityPrior>& gravity,
+std::string invalidInput(const ObjectMap& map, const Intrinsics& K, const std::optional<GravityPrior>& gravity,
                          const std::optional<PoseRegion>& region, const RelocalizerOptions& options) {
   if (!K.isValid()) return "invalid intrinsics";
+  if (!validUnitMetres(map.unit_metres)) return "invalid map unit_metres (not a length of 1e-6 to 1e6 metres)";
   if (gravity && !gravity->isValid())
     return "invalid gravity prior (zero or non-finite direction, or sigma not positive)";
   if (region && !region->isValid())
@@ -176,7 +177,7 @@ RelocalizationResult ObjectRelocalizer::scorePoseInOrder(const std::vector<Obser
                                                          const Pose& pose) const {
   RelocalizationResult result;
   result.pose = pose;
-  const std::string invalid = invalidInput(K_, std::nullopt, std::nullopt, options_);
+  const std::string invalid = invalidInput(map_, K_, std::nullopt, std::nullopt, options_);
   if (!invalid.empty() || !pose.isValid()) {
     result.status = RelocalizationStatus::InvalidInput;
     result.reason = invalid.empty() ? "invalid pose" : invalid;
@@ -197,7 +198,7 @@ RelocalizationResult ObjectRelocalizer::scorePoseInOrder(const std::vector<Obser
 
 RelocalizationResult ObjectRelocalizer::refineFromInOrder(const std::vector<Observation>& observations,
                                                           const Pose& start) const {
-  if (!invalidInput(K_, std::nullopt, std::nullopt, options_).empty() || !start.isValid())
+  if (!invalidInput(map_, K_, std::nullopt, std::nullopt, options_).empty() || !start.isValid())
     return scorePoseInOrder(observations, start);  // says why
   std::vector<std::pair<int, std::string>> skipped;
   const Candidates candidates =
@@ -276,7 +277,7 @@ RelocalizationResult ObjectRelocalizer::relocalizeInOrder(const std::vector<Obse
     result.reason = std::move(reason);
     return result;
   };
-  const std::string invalid = invalidInput(K_, gravity, region, options_);
+  const std::string invalid = invalidInput(map_, K_, gravity, region, options_);
   if (!invalid.empty()) return finish(RelocalizationStatus::InvalidInput, invalid);
 
   // 1. Candidates: three usable observations for P3P, two for the two-object solver, one with gravity.

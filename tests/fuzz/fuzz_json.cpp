@@ -12,7 +12,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     const ObjectMap m = io::parseMapJson(text, "fuzz.json");
-    for (const MapObject& o : m.objects) FUZZ_CHECK(o.ellipsoid.isValid());  // the reader promises valid ellipsoids
+    // The reader promises valid ellipsoids that relocalization can use, and a unit that is a length.
+    FUZZ_CHECK(validUnitMetres(m.unit_metres));
+    for (const MapObject& o : m.objects) FUZZ_CHECK(o.ellipsoid.isValid() && mapObjectUsable(o, m.unit_metres));
   } catch (const Error&) {
   }
   try {

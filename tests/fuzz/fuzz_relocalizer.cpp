@@ -23,6 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                             Eigen::AngleAxisd(num(-4, 4), Eigen::Vector3d::UnitZ()).toRotationMatrix());
     map.objects.push_back(o);
   }
+  if (in.small(4) == 0) map.unit_metres = raw ? in.real() : std::exp(in.scaled(-8, 8));  // a monocular map's unit
   std::vector<Observation> observations;
   const int n = in.small(10);
   for (int i = 0; i < n; ++i) {
@@ -48,6 +49,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const ObjectRelocalizer relocalizer(map, Intrinsics(525, 525, 319.5, 239.5, 640, 480), options);
   const RelocalizationResult r = relocalizer.relocalize(observations, {}, gravity, region);
   FUZZ_CHECK(r.status != RelocalizationStatus::Success || r.pose.isValid());
+  FUZZ_CHECK(validUnitMetres(map.unit_metres) || r.status == RelocalizationStatus::InvalidInput);
   // A pose found in a region lies in it; an invalid region is a status.
   FUZZ_CHECK(!region || !region->isValid() || r.status != RelocalizationStatus::Success || region->admits(r.pose));
   FUZZ_CHECK(!region || region->isValid() || r.status == RelocalizationStatus::InvalidInput);
@@ -68,7 +70,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       FUZZ_CHECK(odometry.isValid() ||
                  (t.result.status == RelocalizationStatus::InvalidInput && track.size() == before));
       FUZZ_CHECK(track.size() <= track_options.max_frames);
-      FUZZ_CHECK(std::isfinite(t.scale) && t.scale >= 0.0 && (!track_options.metric_odometry || t.scale == 1.0));
+      FUZZ_CHECK(std::isfinite(t.scale) && t.scale >= 0.0 &&
+                 (!track_options.metric_odometry || t.result.status == RelocalizationStatus::InvalidInput ||
+                  t.scale == 1.0 / map.unit_metres));
     }
   }
   return 0;

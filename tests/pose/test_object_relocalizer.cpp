@@ -281,6 +281,14 @@ TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {
   const RelocalizationResult rg = reloc.relocalize(s.observations, {}, zero);
   EXPECT_EQ(rg.status, RelocalizationStatus::InvalidInput);
   EXPECT_NE(rg.reason.find("gravity"), std::string::npos);
+  // A map whose unit is no length.
+  for (const double unit : {0.0, -2.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    ObjectMap map = s.map;
+    map.unit_metres = unit;
+    const RelocalizationResult ri = ObjectRelocalizer(map, K).relocalize(s.observations);
+    EXPECT_EQ(ri.status, RelocalizationStatus::InvalidInput);
+    EXPECT_NE(ri.reason.find("unit_metres"), std::string::npos) << ri.reason;
+  }
 }
 
 // A host process must be able to bound the work: 200 objects of one category and 50
