@@ -244,6 +244,7 @@ class KeyframeReport:
     matched_3d: int
     new_objects: int
     ignored: int
+    object_ids: list[int]
 
 
 class Keypoint:
@@ -299,6 +300,7 @@ class Mapper:
     def add_keyframe(self, pose: Pose, detections: Sequence[Detection], depth: ArrayLike | None = ..., depth_scale: float = ...) -> KeyframeReport: """Adds a keyframe: world->camera pose, detections, and (voxel mode) the depth image, (height, width) uint16 in depth_scale units per metre (TUM: 5000) or float metres. On error the map is unchanged."""
     def finish(self) -> None: """Boxes mode: refits every object whose views grew. Call after the last keyframe."""
     def update_keyframe_poses(self, poses: Sequence[Pose]) -> None: """The host moved its keyframes (bundle adjustment, loop closure): the world->camera pose of every keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves each object with the keyframe that saw it last; objects that now coincide are joined. On error the map is unchanged."""
+    def current_object_id(self, id: int) -> Optional[int]: """The id an object a KeyframeReport named has now (objects found to be one are joined, the younger into the older), or None for a candidate forgotten before it was confirmed."""
     def estimated_unit_metres(self, min_objects: int = ...) -> Optional[float]: """Boxes mode: the poses' unit in metres that the triangulated objects' sizes tell (None with fewer than min_objects of them): map again with it as MapperOptions.unit_metres until it settles."""
     def map(self) -> ObjectMap: """The current object map."""
     def objects(self) -> list[MappedObject]: """The objects in the map with what the mapper knows about each (MappedObject), in map order."""

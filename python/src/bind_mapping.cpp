@@ -113,7 +113,10 @@ void bindMapperClass(py::module_& m) {
       .def_readonly("tracked_2d", &KeyframeReport::tracked_2d)
       .def_readonly("matched_3d", &KeyframeReport::matched_3d)
       .def_readonly("new_objects", &KeyframeReport::new_objects)
-      .def_readonly("ignored", &KeyframeReport::ignored);
+      .def_readonly("ignored", &KeyframeReport::ignored)
+      .def_readonly("object_ids", &KeyframeReport::object_ids,
+                    "For each detection, in the order given: the id of the object it joined (as map() names it once "
+                    "it is in the map), or -1 when ignored; Mapper.current_object_id follows later joins.");
   py::class_<Cuboid>(m, "Cuboid", "The yaw-aligned cuboid a voxel object's ellipsoid is inscribed in.")
       .def_property_readonly("center", [](const Cuboid& c) { return toArray(c.center); })
       .def_property_readonly(
@@ -178,6 +181,9 @@ void bindMapperClass(py::module_& m) {
            "keyframe added so far, in order. Boxes mode refits every object at the new poses; voxel mode moves "
            "each object with the keyframe that saw it last; objects that now coincide are joined. On error the map "
            "is unchanged.")
+      .def("current_object_id", &Mapper::currentObjectId, py::arg("id"),
+           "The id an object a KeyframeReport named has now (objects found to be one are joined, the younger "
+           "into the older), or None for a candidate forgotten before it was confirmed.")
       .def("estimated_unit_metres", &Mapper::estimatedUnitMetres, py::arg("min_objects") = 5,
            "Boxes mode: the poses' unit in metres that the triangulated objects' sizes tell (None with fewer than "
            "min_objects of them): map again with it as MapperOptions.unit_metres until it settles.")

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <numeric>
 #include <tuple>
 
 #include "ellreloc/core/mask.hpp"
@@ -91,14 +92,16 @@ bool reportedTwice(const std::vector<Detection>& detections, size_t j) {
 /// (stable for detections equal in all of them), so that which detection starts a track, and so
 /// the objects' ids, does not depend on the order a detector lists its boxes in. The keyframe is
 /// checked first: every value compared is finite.
-std::vector<Detection> inCanonicalOrder(const std::vector<Detection>& detections) {
-  const auto key = [](const Detection& d) {
+/// The detections' indices in the canonical order.
+std::vector<size_t> canonicalOrder(const std::vector<Detection>& detections) {
+  const auto key = [&](size_t i) {
+    const Detection& d = detections[i];
     return std::make_tuple(-d.score, d.category_id, d.bbox.x1, d.bbox.y1, d.bbox.x2, d.bbox.y2);
   };
-  std::vector<Detection> ordered = detections;
-  std::stable_sort(ordered.begin(), ordered.end(),
-                   [&](const Detection& a, const Detection& b) { return key(a) < key(b); });
-  return ordered;
+  std::vector<size_t> order(detections.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
+  return order;
 }
 
 /// The 10th and 90th percentiles of the camera depths of an object's occupied voxels
@@ -243,7 +246,11 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
       floor_in_camera_.emplace_back(keyframes_, pose.rotation() * (plane->inlier_share * plane->up));
     }
   }
-  std::vector<Detection> ordered = inCanonicalOrder(detections);
+  const std::vector<size_t> order = canonicalOrder(detections);
+  std::vector<Detection> ordered;
+  ordered.reserve(order.size());
+  for (size_t i : order) ordered.push_back(detections[i]);
+  report.object_ids.assign(ordered.size(), -1);  // in the canonical order until the keyframe is done
   std::vector<bool> cut;  // by the raw image's border, for boxes undistorted from it
   if (options_.lens)
     for (Detection& d : ordered) {
@@ -262,6 +269,11 @@ KeyframeReport Mapper::addKeyframe(const Pose& pose, const std::vector<Detection
                                }),
                 tracks_.end());
   ++keyframes_;
+  // Each detection's object as it is now (this keyframe's joins done), in the order given.
+  std::vector<int> ids(order.size(), -1);
+  for (size_t k = 0; k < order.size(); ++k)
+    if (report.object_ids[k] >= 0) ids[order[k]] = currentObjectIdLocked(report.object_ids[k]).value_or(-1);
+  report.object_ids = std::move(ids);
   return report;
 }
 
@@ -427,6 +439,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
       t.voxels.integrate(K_, pose, depth, masks[k]);
       observed(t, d);
       ++report->tracked_2d;
+      report->object_ids[used[k]] = t.id;
       continue;
     }
     // 3D matching: the detection's own voxels against every object of its label (eq. 4).
@@ -448,6 +461,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
       match->voxels.integrate(K_, pose, depth, masks[k]);
       observed(*match, d);
       ++report->matched_3d;
+      report->object_ids[used[k]] = match->id;
       continue;
     }
     Track t;
@@ -456,6 +470,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     tracks_.push_back(std::move(t));
     observed(tracks_.back(), d);
     ++report->new_objects;
+    report->object_ids[used[k]] = tracks_.back().id;
   }
   mergeDuplicateVoxelTracks();
 }
@@ -497,7 +512,7 @@ void Mapper::mergeDuplicateVoxelTracks(bool every_pair) {
         a.voxels.prune(options_.prune_probability);
         rebuild(a);
       }
-      tracks_.erase(tracks_.begin() + static_cast<long>(j));
+      forgetJoined(i, j);
       --j;
     }
   }
@@ -572,6 +587,7 @@ void Mapper::addBoxKeyframe(const Pose& pose, const std::vector<Detection>& dete
     t->views.push_back({pose, d.bbox, cut.empty() ? std::nullopt : std::optional<bool>(cut[used[k]])});
     t->view_keyframes.push_back(keyframes_);
     observed(*t, d);
+    report->object_ids[used[k]] = t->id;
   }
   mergeDuplicateBoxTracks();
 }
@@ -610,10 +626,27 @@ void Mapper::mergeDuplicateBoxTracks() {
       a.observations += b.observations;
       a.last_seen = std::max(a.last_seen, b.last_seen);
       rebuild(a);
-      tracks_.erase(tracks_.begin() + static_cast<long>(j));
+      forgetJoined(i, j);
       --j;
     }
   }
+}
+
+void Mapper::forgetJoined(size_t i, size_t j) {
+  joined_into_[tracks_[j].id] = tracks_[i].id;
+  tracks_.erase(tracks_.begin() + static_cast<long>(j));
+}
+
+std::optional<int> Mapper::currentObjectId(int id) const {
+  std::shared_lock lock(mutex_);
+  return currentObjectIdLocked(id);
+}
+
+std::optional<int> Mapper::currentObjectIdLocked(int id) const {
+  // Joins only go from a younger id to an older one, so the chain ends.
+  for (auto next = joined_into_.find(id); next != joined_into_.end(); next = joined_into_.find(id)) id = next->second;
+  const bool alive = std::any_of(tracks_.begin(), tracks_.end(), [id](const Track& t) { return t.id == id; });
+  return alive ? std::optional<int>(id) : std::nullopt;
 }
 
 Eigen::Vector3d Mapper::upLocked() const {

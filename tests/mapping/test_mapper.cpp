@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <numeric>
 #include <random>
+#include <set>
 #include <thread>
 
 #include "ellreloc/core/mask.hpp"
@@ -253,14 +255,22 @@ TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
 
   Mapper broken(K, options);
   int created = 0;
+  std::vector<int> reported;  // the object each keyframe's box joined, as the keyframe reported it
   for (int i = 0; i < 12; ++i) {
     const Pose pose = arcPose(i);
-    created += broken.addKeyframe(pose, {boxOf(lower, kBook, K, pose, i < 6 ? 1.0 : 0.4)}).new_objects;
+    const KeyframeReport r = broken.addKeyframe(pose, {boxOf(lower, kBook, K, pose, i < 6 ? 1.0 : 0.4)});
+    created += r.new_objects;
+    ASSERT_EQ(r.object_ids.size(), 1u);
+    reported.push_back(r.object_ids[0]);
   }
   broken.finish();
   EXPECT_EQ(created, 2);  // the smaller boxes overlap the object's image too little to be tracked
   const ObjectMap one = broken.map();
   ASSERT_EQ(one.objects.size(), 1u);
+  // The second track's boxes were reported under its own id until it joined the first.
+  EXPECT_EQ(std::set<int>(reported.begin(), reported.end()).size(), 2u);
+  for (const int id : reported) EXPECT_EQ(broken.currentObjectId(id), one.objects[0].id);
+  EXPECT_FALSE(broken.currentObjectId(99).has_value());
   EXPECT_EQ(broken.objects()[0].observations, 12);
   EXPECT_LT((one.objects[0].ellipsoid.center() - lower.center()).norm(), 0.05);
 
@@ -272,12 +282,37 @@ TEST(Mapper, BoxesOfOneKeyframeAreTwoObjectsAndABrokenTrackIsJoined) {
     first.score = 0.6;
     second.score = 0.9;
     second.bbox.x1 += 2.0;  // the same object, boxed a little differently
-    ignored += twice.addKeyframe(pose, {first, second}).ignored;
+    const KeyframeReport r = twice.addKeyframe(pose, {first, second});
+    ignored += r.ignored;
+    EXPECT_EQ(r.object_ids, (std::vector<int>{-1, 0}));  // in the order given
   }
   twice.finish();
   EXPECT_EQ(ignored, 12);  // the less confident report of each keyframe
   ASSERT_EQ(twice.map().objects.size(), 1u);
   EXPECT_LT((twice.map().objects[0].ellipsoid.center() - lower.center()).norm(), 0.05);
+}
+
+// A keyframe's report names each detection's object; a stray box seen once starts a candidate
+// that, never seen again, is forgotten: its id then names no object.
+TEST(Mapper, ACandidateNeverConfirmedIsForgotten) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const Ellipsoid book(Eigen::Vector3d(0, 0, 0.02), Eigen::Vector3d(0.12, 0.09, 0.02), Eigen::Matrix3d::Identity());
+  const Ellipsoid cup(Eigen::Vector3d(0.3, -0.3, 0.05), Eigen::Vector3d(0.04, 0.04, 0.05), Eigen::Matrix3d::Identity());
+  Mapper mapper(K, boxesMode());
+  const KeyframeReport first =
+      mapper.addKeyframe(arcPose(0), {boxOf(book, 73, K, arcPose(0)), boxOf(cup, 41, K, arcPose(0))});
+  ASSERT_EQ(first.object_ids.size(), 2u);
+  const int book_id = first.object_ids[0], cup_id = first.object_ids[1];
+  ASSERT_GE(cup_id, 0);
+  EXPECT_NE(book_id, cup_id);
+  EXPECT_EQ(mapper.currentObjectId(cup_id), cup_id);  // a candidate, not in the map yet
+  for (int i = 1; i <= mapper.options().candidate_lifetime + 1; ++i) {
+    const KeyframeReport r = mapper.addKeyframe(arcPose(i), {boxOf(book, 73, K, arcPose(i))});
+    EXPECT_EQ(r.object_ids, std::vector<int>{book_id});
+  }
+  EXPECT_FALSE(mapper.currentObjectId(cup_id).has_value());
+  ASSERT_EQ(mapper.map().objects.size(), 1u);
+  EXPECT_EQ(mapper.currentObjectId(book_id), mapper.map().objects[0].id);
 }
 
 // Boxes mode with keyframes far apart, as a SLAM system gives them: a camera sliding 10 cm per
@@ -325,12 +360,22 @@ TEST(Mapper, TheOrderOfTheDetectionsDoesNotMatter) {
     options.mode = mode;
     Mapper given(seq.K, options), shuffled(seq.K, options);
     std::mt19937 rng(5);
+    int associated = 0;
     for (const auto& kf : seq.keyframes) {
-      given.addKeyframe(kf.pose, kf.detections, &kf.depth);
-      std::vector<Detection> reordered = kf.detections;
-      std::shuffle(reordered.begin(), reordered.end(), rng);
-      shuffled.addKeyframe(kf.pose, reordered, &kf.depth);
+      const KeyframeReport a = given.addKeyframe(kf.pose, kf.detections, &kf.depth);
+      std::vector<size_t> order(kf.detections.size());
+      std::iota(order.begin(), order.end(), size_t{0});
+      std::shuffle(order.begin(), order.end(), rng);
+      std::vector<Detection> reordered;
+      for (size_t i : order) reordered.push_back(kf.detections[i]);
+      const KeyframeReport b = shuffled.addKeyframe(kf.pose, reordered, &kf.depth);
+      // Each detection joins the same object, reported in the order each was given.
+      ASSERT_EQ(b.object_ids.size(), order.size());
+      for (size_t k = 0; k < order.size(); ++k) EXPECT_EQ(b.object_ids[k], a.object_ids[order[k]]);
+      associated +=
+          static_cast<int>(std::count_if(a.object_ids.begin(), a.object_ids.end(), [](int id) { return id >= 0; }));
     }
+    EXPECT_GT(associated, 30) << toString(mode);
     given.finish();
     shuffled.finish();
     const std::vector<MappedObject> a = given.objects(), b = shuffled.objects();
@@ -629,20 +674,23 @@ TEST(Mapper, ALoopClosureJoinsTheTwoObjectsADriftMadeOfOne) {
   const Pose drift(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.4, 0.0, 0.0));
   Mapper mapper(K, boxesMode());
   std::vector<Pose> poses;
+  std::set<int> reported;
   for (int i = 0; i < 20; ++i) {
     const bool away = i >= 8 && i < 12;
     const Pose pose =
         away ? Pose::lookAt(Eigen::Vector3d(1.5, 0, 0.8), Eigen::Vector3d(3, 0, 0.8)) : arcPose(i < 8 ? i : 19 - i);
     std::vector<Detection> boxes;
     if (!away) boxes.push_back(boxOf(book, kBook, K, pose));
-    mapper.addKeyframe(i < 12 ? pose : pose * drift, boxes);
+    for (const int id : mapper.addKeyframe(i < 12 ? pose : pose * drift, boxes).object_ids) reported.insert(id);
     poses.push_back(pose);
   }
   mapper.finish();
   ASSERT_EQ(mapper.map().objects.size(), 2u);
+  EXPECT_EQ(reported.size(), 2u);
   mapper.updateKeyframePoses(poses);
   const ObjectMap map = mapper.map();
   ASSERT_EQ(map.objects.size(), 1u);
+  for (const int id : reported) EXPECT_EQ(mapper.currentObjectId(id), map.objects[0].id);  // the younger joined
   EXPECT_LT((map.objects[0].ellipsoid.center() - book.center()).norm(), 0.02);
   EXPECT_EQ(mapper.objects()[0].observations, 16);
 }

@@ -86,6 +86,11 @@ struct KeyframeReport {
   int matched_3d = 0;   ///< associated by 3D voxel matching
   int new_objects = 0;  ///< started a new object
   int ignored = 0;      ///< below min_score or min_mask_pixels
+  /// For each detection, in the order given: the id of the object it joined (as map() and
+  /// objects() name it once it is in the map: a candidate until seen min_observations times),
+  /// or -1 when it was ignored. A later keyframe may join that object into an older one or
+  /// forget a candidate never confirmed: Mapper::currentObjectId follows.
+  std::vector<int> object_ids;
 };
 
 /// A mapped object with what the mapper knows about it.
@@ -148,6 +153,11 @@ class Mapper {
   /// unit far off splits objects, so map the keyframes again with the estimate until it settles
   /// (two or three passes). nullopt with fewer than `min_objects` such objects, or in voxel mode.
   std::optional<double> estimatedUnitMetres(int min_objects = 5) const;
+  /// The id that an object a KeyframeReport named has now: two objects found to be one are
+  /// joined (the younger into the older, whose id stays), as while mapping or after
+  /// updateKeyframePoses. nullopt for a candidate forgotten before it was confirmed (seen fewer
+  /// than min_observations times, then not for candidate_lifetime keyframes) or an id never given.
+  std::optional<int> currentObjectId(int id) const;
 
   /// The objects in the map (those with an ellipsoid), in the order they were created, and
   /// the camera envelope of the keyframes (heights and tilts along the world's up in voxel
@@ -191,6 +201,9 @@ class Mapper {
   /// Pairs with an object updated in this keyframe (the others cannot have changed), or every
   /// pair once the keyframes moved.
   void mergeDuplicateVoxelTracks(bool every_pair = false);
+  /// Track `j` joins track `i` (its views, labels and observations already added there).
+  void forgetJoined(size_t i, size_t j);
+  std::optional<int> currentObjectIdLocked(int id) const;
   void rebuild(Track& track) const;
   /// Boxes mode: the size prior of a category, in the world's unit.
   BoxSizePrior sizePrior(int category) const;
@@ -204,6 +217,7 @@ class Mapper {
   int keyframes_ = 0;
   std::vector<Pose> keyframe_poses_;  // for the map's camera envelope
   int next_id_ = 0;
+  std::map<int, int> joined_into_;  // the id of a joined track -> the id of the track it joined
   Eigen::Vector3d floor_normal_sum_ = Eigen::Vector3d::Zero();
   // Each keyframe's floor normal (times its inlier share) in its camera's frame, for
   // updateKeyframePoses.
