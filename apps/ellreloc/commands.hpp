@@ -69,6 +69,7 @@ struct MapArgs {
   std::vector<double> up;  ///< the world's up direction, when known
   bool undistort = false;  ///< the detections and depth images are raw images of the camera's distorted lens
   std::string unit_metres = "1";  ///< boxes mode: the trajectory's unit in metres, or "auto"
+  std::string detections_out;     ///< the detections again, each with the map object it joined
 };
 CLI::App* addMapCommand(CLI::App& app, MapArgs& a);
 void map(const MapArgs& a, const Console& console);

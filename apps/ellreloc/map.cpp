@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <utility>
 
 #include "commands.hpp"
@@ -127,6 +128,9 @@ CLI::App* addMapCommand(CLI::App& app, MapArgs& a) {
                 "boxes mode: the length of the trajectory's unit in metres, for a monocular SLAM system's poses; "
                 "auto: the unit the objects' sizes tell (the frames mapped again until it settles)")
       ->capture_default_str();
+  m->add_option("--detections-out", a.detections_out,
+                "write the detections again, each box's object_id the map object it joined (left out for a box "
+                "that joined none of the map's objects, or was not mapped)");
   m->add_option("--holdout-every", a.holdout_every,
                 "leave every N-th frame out of the map and report how well the map explains its boxes")
       ->check(CLI::Range(2, 1000000));
@@ -154,12 +158,14 @@ struct MappingPass {
   std::unique_ptr<Mapper> mapper;
   int used = 0, no_pose = 0, no_depth = 0;
   std::vector<PosedDetections> held_out;  // --holdout-every's frames
+  std::vector<std::vector<int>> object_ids;  // per frame, its report's (empty: not mapped)
 };
 
 MappingPass mapFrames(const MapArgs& a, const MapperOptions& options, const Intrinsics& K, const MapInputs& in,
                       const Console& console) {
   MappingPass pass;
   pass.mapper = std::make_unique<Mapper>(K, options);
+  pass.object_ids.resize(in.frames.size());
   for (size_t i = 0; i < in.frames.size(); ++i) {
     const DetectionFrame& f = in.frames[i];
     if (a.holdout_every > 0 && i % static_cast<size_t>(a.holdout_every) == static_cast<size_t>(a.holdout_every) - 1) {
@@ -184,8 +190,10 @@ MappingPass mapFrames(const MapArgs& a, const MapperOptions& options, const Intr
       depth = io::readDepthPng(assoc->depth_path);
     }
     try {
-      pass.mapper->addKeyframe(in.trajectory[*k].pose, f.detections,
-                               options.mode == MappingMode::Voxel ? &depth : nullptr);
+      pass.object_ids[i] =
+          pass.mapper
+              ->addKeyframe(in.trajectory[*k].pose, f.detections, options.mode == MappingMode::Voxel ? &depth : nullptr)
+              .object_ids;
     } catch (const Error& e) {
       throw Error(a.detections + ": " + f.file_name + ": " + e.what());
     }
@@ -230,12 +238,29 @@ MappingPass mapInTheUnit(const MapArgs& a, MapperOptions& options, const Intrins
   return pass;
 }
 
+/// --detections-out: the frames with each box's object_id the map object it joined, if any.
+void writeAssociatedDetections(const std::string& path, std::vector<DetectionFrame> frames, const MappingPass& pass,
+                               const ObjectMap& map) {
+  std::set<int> in_map;
+  for (const MapObject& o : map.objects) in_map.insert(o.id);
+  for (size_t i = 0; i < frames.size(); ++i)
+    for (size_t j = 0; j < frames[i].detections.size(); ++j) {
+      std::optional<int>& id = frames[i].detections[j].object_id;
+      id.reset();
+      if (j < pass.object_ids[i].size() && pass.object_ids[i][j] >= 0)
+        if (const std::optional<int> now = pass.mapper->currentObjectId(pass.object_ids[i][j]);
+            now && in_map.count(*now))
+          id = now;
+    }
+  io::writeDetections(path, frames);
+}
+
 void map(const MapArgs& a, const Console& console) {
-  checkPaths({{"--out", a.out}}, {{"--camera", a.camera},
-                                  {"--associations", a.associations},
-                                  {"--trajectory", a.trajectory},
-                                  {"--detections", a.detections},
-                                  {"--holdout", a.holdout}});
+  checkPaths({{"--out", a.out}, {"--detections-out", a.detections_out}}, {{"--camera", a.camera},
+                                                                          {"--associations", a.associations},
+                                                                          {"--trajectory", a.trajectory},
+                                                                          {"--detections", a.detections},
+                                                                          {"--holdout", a.holdout}});
   MapperOptions options;
   // With --undistort the camera file is read once, as a lens whose intrinsics are the pinhole image's.
   if (a.undistort) options.lens = io::readLens(a.camera);
@@ -276,6 +301,7 @@ void map(const MapArgs& a, const Console& console) {
                                       }),
                        result.objects.end());
   io::writeMap(a.out, result);
+  if (!a.detections_out.empty()) writeAssociatedDetections(a.detections_out, in.frames, pass, result);
   if (!console.quiet) {
     // Boxes mode reads no depth: only voxel mode can miss one.
     const std::string no_depth_text =
