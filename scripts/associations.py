@@ -1,22 +1,26 @@
 #!/usr/bin/env python3
-"""How the boxes mapper associates real detections, against a reference association: fr2_desk's
-keyframe boxes (../shared/data/tum_fr2_desk), each of which GOReloc's own mapping associated with
-one of its map objects (`object_id`; 1,185 of 1,200), mapped in boxes mode at the keyframes' poses.
-Each box's object is the one its keyframe's report named (`KeyframeReport.object_ids`), followed
-through later joins (`Mapper.current_object_id`). Prints a Markdown table:
+"""How the mapper associates detections with objects, against a reference association. Each box's
+object is the one its keyframe's report named (`KeyframeReport.object_ids`), followed through
+later joins (`Mapper.current_object_id`); boxes that joined none of the map's objects are left
+out. Two data sets:
 
-- pairs: over the pairs of boxes that both associations hold in a map object, the share of the
-  pairs ours puts in one object that the reference does too (precision) and the reverse (recall);
-- split: reference objects with at least 3 boxes in each of two or more of our objects;
-- merged: our objects with at least 3 boxes of each of two or more reference objects.
+- fr2_desk's keyframe boxes (../shared/data/tum_fr2_desk), boxes mode at the keyframes' poses.
+  The reference is the association GOReloc's own mapping made (`object_id`, 1,185 of 1,200
+  boxes): not a ground truth, since it gives a fifth of its boxes to an object of another
+  category; a second row keeps the boxes of their reference object's category.
+- office_s11's 40 mapping keyframes (independent renderer), voxel mode with their depth images
+  and boxes mode, against the true object of each detection (mapping.ellipse_truth.json; false
+  positives have none).
 
-The reference is GOReloc's tracker, not a ground truth (it gives a fifth of its boxes to an object
-of another category): read the figures as agreement.
+Prints a Markdown table: over the pairs of boxes that both associations hold in an object, the
+share of the pairs ours puts in one object that the reference does too (precision) and the
+reverse (recall); the reference objects split over two of ours, and our objects merging two of
+the reference's (at least 3 boxes each).
 
 Usage: PYTHONPATH=BUILD/python python3 scripts/associations.py [DATA_DIR]
 """
 import collections
-import itertools
+import json
 import os
 import sys
 
@@ -26,7 +30,7 @@ MIN_BOXES = 3  # boxes of one object in another that make a split or a merge
 
 
 def agreement(pairs):
-    """pairs: (reference id, our id) per box; ids of boxes in no object left out."""
+    """pairs: (reference id, our id) per box. Precision, recall, split, merged, reference objects, ours."""
     def together(key):
         groups = collections.Counter(key(p) for p in pairs)
         return sum(n * (n - 1) // 2 for n in groups.values())
@@ -41,37 +45,80 @@ def agreement(pairs):
     return both / ours, both / reference, split, merged, len(ours_of), len(reference_of)
 
 
-def main():
-    data = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data")
+def mapped(camera, mode, keyframes):
+    """keyframes: (pose, detections, depth or None, references per detection). The mapper and,
+    per box, (reference id or None, our object's id now or None)."""
+    mapper = ellreloc.Mapper(camera, mode=mode)
+    reported = []
+    for pose, detections, depth, references in keyframes:
+        report = mapper.add_keyframe(pose, detections, depth) if depth is not None else \
+            mapper.add_keyframe(pose, detections)
+        reported += list(zip(references, report.object_ids))
+    mapper.finish()
+    in_map = {o.id for o in mapper.map().objects}
+    boxes = []
+    for r, i in reported:
+        now = mapper.current_object_id(i) if i >= 0 else None
+        boxes.append((r, now if now in in_map else None))
+    return mapper, boxes
+
+
+def row(name, mapper, boxes):
+    pairs = [(r, o) for r, o in boxes if r is not None and o is not None]
+    precision, recall, split, merged, references, ours = agreement(pairs)
+    return (f"| {name} | {len(boxes)} | {sum(r is not None for r, _ in boxes)} | {len(pairs)} (in {ours} of our "
+            f"{len(mapper.map().objects)} objects) | {precision:.3f} / {recall:.3f} | {split} of {references} | "
+            f"{merged} of {ours} |")
+
+
+def fr2_rows(data):
     folder = os.path.join(data, "tum_fr2_desk")
     camera = ellreloc.read_camera(os.path.join(folder, "camera.yaml"))
     truth = ellreloc.read_trajectory(os.path.join(folder, "keyframes.groundtruth.txt"))
     index = ellreloc.time_index(truth)
-    mapper = ellreloc.Mapper(camera, mode="boxes")
-    reference_category = {o.id: o.category for o in ellreloc.read_map(os.path.join(folder, "map.json")).objects}
-    boxes = []  # (reference id or None, our id as reported, the box's category is its reference object's)
+    category = {o.id: o.category for o in ellreloc.read_map(os.path.join(folder, "map.json")).objects}
+    keyframes, same_category = [], []
     for frame in ellreloc.read_detections(os.path.join(folder, "keyframes.detections.json")):
         k = index.nearest(frame.timestamp)
-        if k is None:
-            continue
-        report = mapper.add_keyframe(truth[k].pose, frame.detections)
-        boxes += [(d.object_id, i, reference_category.get(d.object_id) == d.category_id)
-                  for d, i in zip(frame.detections, report.object_ids)]
-    mapper.finish()
-    in_map = {o.id for o in mapper.map().objects}
-    print("| boxes of fr2_desk's keyframes | boxes | with a reference object | in one of our objects "
-          "| pairs: precision / recall | reference objects split | our objects merging two |")
+        if k is not None:
+            keyframes.append((truth[k].pose, frame.detections, None, [d.object_id for d in frame.detections]))
+            same_category += [category.get(d.object_id) == d.category_id for d in frame.detections]
+    mapper, boxes = mapped(camera, "boxes", keyframes)
+    kept = [b for b, same in zip(boxes, same_category) if same]
+    return [row("fr2_desk keyframes, boxes mode (reference: GOReloc's association)", mapper, boxes),
+            row("the same, the boxes of their reference object's category", mapper, kept)]
+
+
+def office_rows(data):
+    folder = os.path.join(data, "independent_synth", "office_s11")
+    camera = ellreloc.read_camera(os.path.join(folder, "camera.yaml"))
+    trajectory = ellreloc.read_trajectory(os.path.join(folder, "mapping.trajectory.txt"))
+    index = ellreloc.time_index(trajectory)
+    associations = ellreloc.AssociationIndex(ellreloc.read_associations(os.path.join(folder, "associations.txt")))
+    with open(os.path.join(folder, "mapping.ellipse_truth.json")) as f:
+        truth = {t["file_name"]: {d["det_index"]: d["object_id"] for d in t["detections"]} for t in json.load(f)}
+    keyframes = []
+    for frame in ellreloc.read_detections(os.path.join(folder, "mapping.detections.json")):
+        a = associations.find(os.path.join(folder, frame.file_name), frame.timestamp)
+        pose = trajectory[index.nearest(a.rgb_time)].pose
+        true_object = truth.get(frame.file_name, {})
+        references = [true_object.get(j) for j in range(len(frame.detections))]
+        keyframes.append((pose, frame.detections, ellreloc.read_depth_png(a.depth_path), references))
+    rows = []
+    for mode in ("voxel", "boxes"):
+        mapper, boxes = mapped(camera, mode, keyframes if mode == "voxel" else
+                               [(p, d, None, r) for p, d, _, r in keyframes])
+        rows.append(row(f"office_s11 mapping keyframes, {mode} mode (reference: the true objects)", mapper, boxes))
+    return rows
+
+
+def main():
+    data = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data")
+    print("| data, mode (reference) | boxes | with a reference object | in one of our objects | pairs: precision / recall "
+          "| reference objects split | our objects merging two |")
     print("|---|---|---|---|---|---|---|")
-    for name, keep in (("all", lambda same: True), ("of their reference object's category", lambda same: same)):
-        kept = [(r, i) for r, i, same in boxes if keep(same)]
-        pairs = []
-        for r, i in kept:
-            now = mapper.current_object_id(i) if i >= 0 else None
-            if r is not None and now in in_map:
-                pairs.append((r, now))
-        precision, recall, split, merged, references, ours = agreement(pairs)
-        print(f"| {name} | {len(kept)} | {sum(r is not None for r, _ in kept)} | {len(pairs)} (in {ours} of our "
-              f"{len(in_map)} objects) | {precision:.3f} / {recall:.3f} | {split} of {references} | {merged} of {ours} |")
+    for line in fr2_rows(data) + office_rows(data):
+        print(line)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 """Files and mapping from Python: round trips, errors as exceptions, maps equal to the command line's."""
 
+import json
 import subprocess
 import warnings
 
@@ -257,6 +258,33 @@ def test_each_box_is_reported_with_its_object_and_agrees_with_a_reference(fr2, d
     assert both / together(lambda p: p[1]) > 0.75  # precision
     assert both / together(lambda p: p[0]) > 0.95  # recall
     assert mapper.current_object_id(10**6) is None
+
+
+def test_voxel_mapping_associates_an_independent_scene_as_its_truth(data_dir):
+    """office_s11's 40 mapping keyframes (another renderer) in voxel mode: every box that joined a
+    map object joined its true object's, and no true object is split (scripts/associations.py)."""
+    d = data_dir / "independent_synth" / "office_s11"
+    camera, trajectory = E.read_camera(d / "camera.yaml"), E.read_trajectory(d / "mapping.trajectory.txt")
+    index = E.time_index(trajectory)
+    associations = E.AssociationIndex(E.read_associations(d / "associations.txt"))
+    truth = {t["file_name"]: {b["det_index"]: b["object_id"] for b in t["detections"]}
+             for t in json.loads((d / "mapping.ellipse_truth.json").read_text())}
+    mapper = E.Mapper(camera, mode="voxel")
+    reported = []
+    for frame in E.read_detections(d / "mapping.detections.json"):
+        a = associations.find(d / frame.file_name, frame.timestamp)
+        report = mapper.add_keyframe(trajectory[index.nearest(a.rgb_time)].pose, frame.detections,
+                                     E.read_depth_png(a.depth_path))
+        reported += [(truth[frame.file_name].get(j), i) for j, i in enumerate(report.object_ids)]
+    in_map = {o.id for o in mapper.map().objects}
+    ours_of, true_of = {}, {}
+    for true_id, i in reported:
+        now = mapper.current_object_id(i) if i >= 0 else None
+        if true_id is not None and now in in_map:
+            ours_of.setdefault(true_id, set()).add(now)
+            true_of.setdefault(now, set()).add(true_id)
+    assert len(ours_of) >= 17 and all(len(v) == 1 for v in ours_of.values())
+    assert all(len(v) == 1 for v in true_of.values())
 
 
 def test_the_objects_tell_a_monocular_map_its_unit(data_dir):
