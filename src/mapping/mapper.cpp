@@ -88,11 +88,10 @@ bool reportedTwice(const std::vector<Detection>& detections, size_t j) {
   return false;
 }
 
-/// The detections in a canonical order: detection score highest first, then category and box
-/// (stable for detections equal in all of them), so that which detection starts a track, and so
-/// the objects' ids, does not depend on the order a detector lists its boxes in. The keyframe is
-/// checked first: every value compared is finite.
-/// The detections' indices in the canonical order.
+/// The detections' indices in a canonical order: detection score highest first, then category and
+/// box (stable for detections equal in all of them), so that which detection starts a track, and
+/// so the objects' ids, does not depend on the order a detector lists its boxes in. The keyframe
+/// is checked first: every value compared is finite.
 std::vector<size_t> canonicalOrder(const std::vector<Detection>& detections) {
   const auto key = [&](size_t i) {
     const Detection& d = detections[i];

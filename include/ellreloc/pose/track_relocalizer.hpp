@@ -124,9 +124,9 @@ class TrackRelocalizer {
   /// Every carried frame's poses, carried to the newest frame, each once (5 cm, 3 degrees),
   /// cheapest first.
   std::vector<Carried> rankedPoses(const Carrying& carrying) const;
-  /// Metric odometry: the map's units per metre over the whole track. Otherwise the scale step, near the scale the
-  /// frames' poses propose (or the last one chosen), whose best pose costs least; without
-  /// either, the newest frame alone. Fills `ranked` with that carrying's poses.
+  /// Metric odometry: the map's units per metre over the whole track. Otherwise the scale step,
+  /// near the scale the frames' poses propose (or the last one chosen), whose best pose costs
+  /// least; without either, the newest frame alone. Fills `ranked` with that carrying's poses.
   Carrying chooseCarrying(std::vector<Carried>* ranked);
   /// The scale (map units per odometry unit) pairs of the track's frames propose, or 0.
   double proposedScale() const;
