@@ -117,3 +117,14 @@ def test_the_track_example_beats_each_frame_alone(data_dir):
     valid = {line.split(":")[0]: float(line.split(", ")[1].split("%")[0]) for line in out.splitlines()}
     assert valid["along the track"] > valid["alone"] + 5  # measured: 73.7% against 62.1%
     assert valid["along the track of a monocular odometry"] > valid["alone"] + 5  # measured: 71.7%
+
+
+def test_the_monocular_example_maps_in_the_unit_its_objects_tell(data_dir):
+    example = pathlib.Path(os.environ.get("ELLRELOC_EXAMPLES", pathlib.Path(__file__).parents[2] / "examples" / "python"))
+    env = dict(os.environ, PYTHONPATH=str(PACKAGE.parent))
+    out = subprocess.run([sys.executable, str(example / "monocular.py"), str(data_dir / "tum_fr2_desk")],
+                         check=True, capture_output=True, text=True, env=env).stdout
+    unit = float(out.split("the map records its unit: ")[1].split(" m")[0])
+    assert abs(unit / 2.5 - 1.0) < 0.2, out  # measured 2.18 m: fr2's objects are smaller than typical ones
+    valid = float(out.split("relocalized: 198 keyframes, ")[1].split("%")[0])
+    assert valid > 65.0, out  # measured 72.2%, 3.4 cm told in metres
