@@ -213,7 +213,7 @@ MappingPass mapFrames(const MapArgs& a, const MapperOptions& options, const Intr
 std::optional<double> unitGiven(const std::string& text, MappingMode mode) {
   char* end = nullptr;
   const double unit = text == "auto" ? 0.0 : std::strtod(text.c_str(), &end);
-  if (text != "auto" && (text.empty() || *end != '\0' || !(unit >= 1e-6 && unit <= 1e6)))
+  if (text != "auto" && (text.empty() || *end != '\0' || !validUnitMetres(unit)))
     throw Error("--unit-metres: expected metres (1e-6 to 1e6) or auto, got '" + text + "'");
   if (mode == MappingMode::Voxel && unit != 1.0)
     throw Error("--unit-metres: boxes mode only (voxel mode's depth images are in metres)");

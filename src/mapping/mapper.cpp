@@ -180,7 +180,7 @@ std::string MapperOptions::validate() const {
       {"floor.pixel_stride", double(floor.pixel_stride), 1, 1e6},
       {"floor.iterations", double(floor.iterations), 1, inf},
       {"min_mask_pixels", double(min_mask_pixels), 0, inf},
-      {"unit_metres", unit_metres, 1e-6, 1e6},
+      {"unit_metres", unit_metres, kMinUnitMetres, kMaxUnitMetres},
   };
   for (const Range& r : ranges)
     if (!(r.value >= r.lo && r.value <= r.hi))  // NaN fails too

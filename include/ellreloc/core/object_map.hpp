@@ -48,8 +48,14 @@ struct ObjectMap {
   double unit_metres = 1.0;
 };
 
-/// The map's unit is a length (finite, positive; 1e-6 to 1e6 metres).
-inline bool validUnitMetres(double unit_metres) { return unit_metres >= 1e-6 && unit_metres <= 1e6; }
+/// The lengths a unit of a map's (or a trajectory's) coordinates may have, in metres.
+constexpr double kMinUnitMetres = 1e-6;
+constexpr double kMaxUnitMetres = 1e6;
+
+/// The map's unit is a length (finite, positive; kMinUnitMetres to kMaxUnitMetres).
+inline bool validUnitMetres(double unit_metres) {
+  return unit_metres >= kMinUnitMetres && unit_metres <= kMaxUnitMetres;
+}
 
 /// Semi-axes outside [kMinSemiAxis, kMaxSemiAxis] metres make an object unusable: a
 /// sub-millimetre axis is a degenerate fit (a disc or a needle), above 10 m no indoor object.
