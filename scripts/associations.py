@@ -2,7 +2,7 @@
 """How the mapper associates detections with objects, against a reference association. Each box's
 object is the one its keyframe's report named (`KeyframeReport.object_ids`), followed through
 later joins (`Mapper.current_object_id`); boxes that joined none of the map's objects are left
-out. Two data sets:
+out. The data sets:
 
 - fr2_desk's keyframe boxes (../shared/data/tum_fr2_desk), boxes mode at the keyframes' poses.
   The reference is the association GOReloc's own mapping made (`object_id`, 1,185 of 1,200
@@ -10,14 +10,16 @@ out. Two data sets:
   category; a second row keeps the boxes of their reference object's category.
 - office_s11's 40 mapping keyframes (independent renderer), voxel mode with their depth images
   and boxes mode, against the true object of each detection (mapping.ellipse_truth.json; false
-  positives have none).
+  positives have none);
+- the same for each further scene folder given, of either layout (benchmarks/scene_folder.hpp):
+  `ellreloc simulate`'s scenes, whose truth names each detection's object by its box.
 
 Prints a Markdown table: over the pairs of boxes that both associations hold in an object, the
 share of the pairs ours puts in one object that the reference does too (precision) and the
 reverse (recall); the reference objects split over two of ours, and our objects merging two of
 the reference's (at least 3 boxes each).
 
-Usage: PYTHONPATH=BUILD/python python3 scripts/associations.py [DATA_DIR]
+Usage: PYTHONPATH=BUILD/python python3 scripts/associations.py [DATA_DIR [SCENE_DIR...]]
 """
 import collections
 import json
@@ -89,35 +91,50 @@ def fr2_rows(data):
             row("the same, the boxes of their reference object's category", mapper, kept)]
 
 
-def office_rows(data):
-    folder = os.path.join(data, "independent_synth", "office_s11")
+def scene_rows(folder):
+    """A scene folder of either layout (benchmarks/scene_folder.hpp): its mapping keyframes, voxel
+    and boxes mode, against the true object of each detection (false positives have none)."""
+    independent = os.path.exists(os.path.join(folder, "mapping.detections.json"))
+    base = folder if independent else os.path.join(folder, "mapping")
+    prefix = "mapping." if independent else ""
     camera = ellreloc.read_camera(os.path.join(folder, "camera.yaml"))
-    trajectory = ellreloc.read_trajectory(os.path.join(folder, "mapping.trajectory.txt"))
+    trajectory = ellreloc.read_trajectory(os.path.join(base, prefix + "trajectory.txt"))
     index = ellreloc.time_index(trajectory)
-    associations = ellreloc.AssociationIndex(ellreloc.read_associations(os.path.join(folder, "associations.txt")))
-    with open(os.path.join(folder, "mapping.ellipse_truth.json")) as f:
-        truth = {t["file_name"]: {d["det_index"]: d["object_id"] for d in t["detections"]} for t in json.load(f)}
+    associations = ellreloc.AssociationIndex(ellreloc.read_associations(os.path.join(base, "associations.txt")))
+    with open(os.path.join(base, prefix + "ellipse_truth.json")) as f:
+        truth = {t["file_name"]: t["detections"] for t in json.load(f)}
     keyframes = []
-    for frame in ellreloc.read_detections(os.path.join(folder, "mapping.detections.json")):
-        a = associations.find(os.path.join(folder, frame.file_name), frame.timestamp)
+    for frame in ellreloc.read_detections(os.path.join(base, prefix + "detections.json")):
+        a = associations.find(os.path.join(base, frame.file_name), frame.timestamp)
         pose = trajectory[index.nearest(a.rgb_time)].pose
-        true_object = truth.get(frame.file_name, {})
-        references = [true_object.get(j) for j in range(len(frame.detections))]
+        true_objects = truth.get(frame.file_name, [])
+        if independent:  # the truth names each detection by its index
+            by_index = {t["det_index"]: t["object_id"] for t in true_objects}
+            references = [by_index.get(j) for j in range(len(frame.detections))]
+        else:  # the truth repeats the box of each detection of a true object
+            references = [next((t["object_id"] for t in true_objects
+                                if max(abs(x - y) for x, y in zip(d.bbox.to_array(), t["bbox"])) < 1e-3), None)
+                          for d in frame.detections]
         keyframes.append((pose, frame.detections, ellreloc.read_depth_png(a.depth_path), references))
+    name = os.path.basename(os.path.normpath(folder))
     rows = []
     for mode in ("voxel", "boxes"):
         mapper, boxes = mapped(camera, mode, keyframes if mode == "voxel" else
                                [(p, d, None, r) for p, d, _, r in keyframes])
-        rows.append(row(f"office_s11 mapping keyframes, {mode} mode (reference: the true objects)", mapper, boxes))
+        rows.append(row(f"{name} mapping keyframes, {mode} mode (reference: the true objects)", mapper, boxes))
     return rows
 
 
 def main():
     data = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data")
+    scenes = [os.path.join(data, "independent_synth", "office_s11")] + sys.argv[2:]
     print("| data, mode (reference) | boxes | with a reference object | in one of our objects | pairs: precision / recall "
           "| reference objects split | our objects merging two |")
     print("|---|---|---|---|---|---|---|")
-    for line in fr2_rows(data) + office_rows(data):
+    rows = fr2_rows(data)
+    for scene in scenes:
+        rows += scene_rows(scene)
+    for line in rows:
         print(line)
 
 

@@ -74,7 +74,8 @@ if [ -d "$build/python/ellreloc" ] && [ -n "$python" ]; then
     "$data/independent_synth/office_s11" "$out/scenes/sim_office_1" "$out/scenes/sim_office_2"
   table split_map_limits env PYTHONPATH="$build/python" "$python" scripts/split_map_limits.py "$build" "$data"
   table unit_estimates env PYTHONPATH="$build/python" "$python" scripts/unit_estimates.py "$data"
-  table associations env PYTHONPATH="$build/python" "$python" scripts/associations.py "$data"
+  table associations env PYTHONPATH="$build/python" "$python" scripts/associations.py "$data" \
+    "$out/scenes/sim_office_1" "$out/scenes/sim_office_2"
 else
   echo "benchmarks: python_overhead, regular_verdict, split_map_limits, unit_estimates and associations skipped (no Python bindings in $build)" >&2
 fi

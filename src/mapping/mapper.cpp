@@ -387,6 +387,13 @@ void Mapper::rebuild(Track& track) const {
   track.built = m;
 }
 
+std::optional<Box> Mapper::expectedVoxelBox(const Track& track, const Pose& pose) const {
+  // An object's voxels near its ellipsoid, once it has one: a voxel model holds a few strays
+  // (mask pixels of a neighbour at the same depth), and a box that reaches them can draw the
+  // neighbour's detection to the object once the object itself has left the view.
+  return track.voxels.projectedBox(K_, pose, 10, track.built ? &track.built->object.ellipsoid : nullptr);
+}
+
 void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage& depth,
                               KeyframeReport* report) {
   // The keyframe's usable detections with their masks (a box stands in for a missing mask).
@@ -410,7 +417,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
   std::vector<std::pair<double, double>> depth_ranges;
   for (size_t i = 0; i < tracks_.size(); ++i) {
     if (keyframes_ - tracks_[i].last_seen > options_.track_window) continue;
-    if (const auto box = tracks_[i].voxels.projectedBox(K_, pose)) {
+    if (const auto box = expectedVoxelBox(tracks_[i], pose)) {
       expected.emplace_back(i, std::vector<Box>{*box});
       depth_ranges.push_back(depthRange(tracks_[i].voxels, pose));
     }

@@ -463,6 +463,45 @@ TEST(Mapper, ADetectionIsNotTrackedToAnObjectAtAnotherDepth) {
   EXPECT_EQ(objects[0].observations + objects[1].observations, 7);
 }
 
+// Voxel mode: an object is expected in a keyframe where its ellipsoid projects, not where stray
+// voxels put it. Two books side by side; in one keyframe the left one's mask bleeds onto a strip
+// of the right one (a segmentation error at the same depth), which the right one's detection
+// misses. The camera then moves right, so that the left book leaves the view and the right one
+// sits at its left edge: the strip's voxels still project there, over the right book's
+// detection, but the left book's ellipsoid does not, and the detection joins its own book.
+TEST(Mapper, StrayVoxelsDoNotDrawADetectionToTheirObject) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const int kBook = 73;
+  const Eigen::Vector3d left(0.0, 0.0, 2.0), right(0.35, 0.0, 2.0);
+  const std::vector<std::pair<Eigen::Vector3d, double>> squares{{left, 0.1}, {right, 0.1}};
+  MapperOptions options;
+  options.ellipsoid.up = -Eigen::Vector3d::UnitY();  // the cameras' image-up
+  Mapper mapper(K, options);
+  const auto add = [&](const Eigen::Vector3d& eye, const std::vector<int>& detected, bool bleed) {
+    Squares frame = renderSquares(K, eye, squares, detected, kBook);
+    if (bleed) {  // the right book's left third joins the left book's mask
+      BinaryMask mask = *decodeMask(*frame.detections[0].mask);
+      const Squares both = renderSquares(K, eye, squares, {1}, kBook);
+      const BinaryMask other = *decodeMask(*both.detections[0].mask);
+      const Box b = *maskBox(*both.detections[0].mask);
+      for (int v = 0; v < K.height; ++v)
+        for (int u = 0; u < K.width; ++u)
+          if (other.at(u, v) && u < b.x1 + 0.3 * b.width()) mask.data[static_cast<size_t>(v * K.width + u)] = 1;
+      frame.detections[0].mask = encodeMask(mask);
+      frame.detections[0].bbox = *maskBox(*frame.detections[0].mask);
+    }
+    return mapper.addKeyframe(Pose(Eigen::Matrix3d::Identity(), -eye), frame.detections, &frame.depth);
+  };
+  const Eigen::Vector3d start = Eigen::Vector3d::Zero(), moved(1.4, 0.0, 0.0);
+  std::vector<int> ids;
+  for (int k = 0; k < 3; ++k) ids = add(start, {0, 1}, false).object_ids;
+  const int left_id = ids[0], right_id = ids[1];
+  ASSERT_NE(left_id, right_id);
+  EXPECT_EQ(add(start, {0}, true).object_ids, std::vector<int>{left_id});
+  EXPECT_EQ(add(moved, {1}, false).object_ids, std::vector<int>{right_id});
+  ASSERT_EQ(mapper.objects().size(), 2u);
+}
+
 // Voxel mode: a detection left over by 2D tracking joins the object its voxels match best, not
 // the first that passes eq. 4. Two small books side by side, 1 cm apart, both pass it for a
 // detection of the right one seen again after two keyframes without either; the left one was

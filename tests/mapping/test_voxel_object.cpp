@@ -93,6 +93,39 @@ TEST(VoxelObject, VoxelsLieOnTheBackProjectedSurfaceAndProjectToTheMask) {
   EXPECT_NEAR(box->y2, 300, voxel_px);
 }
 
+// With an ellipsoid, only the voxels within it grown twice make the box: a strip of strays 150
+// px to the right of a plane's voxels stretches the plain box and not that one.
+TEST(VoxelObject, TheBoxNearAnEllipsoidLeavesStraysOut) {
+  VoxelObject v;
+  const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
+  v.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 390, 300));
+  const std::vector<Eigen::Vector3d> plane = v.occupiedCentres();
+  VoxelObject strays;
+  strays.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(540, 240, 545, 260));
+  v.absorb(strays);
+  // The plane's ellipsoid: its voxels' centre, axes along the camera's x and y at that depth
+  // (half of 140 and 100 px at 500 px per 2.5 m), a thin third along the camera's z.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& c : plane) centre += c;
+  centre /= static_cast<double>(plane.size());
+  const Eigen::Matrix3d axes_in_world = camera.rotation().transpose();  // columns: the camera's x, y, z
+  const Ellipsoid ellipsoid(centre, Eigen::Vector3d(0.35, 0.25, 0.01), axes_in_world);
+  const auto plain = v.projectedBox(kVoxelCamera, camera);
+  const auto near = v.projectedBox(kVoxelCamera, camera, 10, &ellipsoid);
+  ASSERT_TRUE(plain && near);
+  const double voxel_px = 500.0 * v.options().voxel_size / 2.5;
+  EXPECT_NEAR(plain->x2, 545, voxel_px);
+  EXPECT_NEAR(near->x1, 250, voxel_px);
+  EXPECT_NEAR(near->x2, 390, voxel_px);
+  EXPECT_NEAR(near->y1, 200, voxel_px);
+  EXPECT_NEAR(near->y2, 300, voxel_px);
+  // Shrunk, it cuts the plane's own sides off: 0.8 of its 70 px half-width each side.
+  const auto tight = v.projectedBox(kVoxelCamera, camera, 10, &ellipsoid, 0.8);
+  ASSERT_TRUE(tight);
+  EXPECT_NEAR(tight->x1, 320 - 56, 2 * voxel_px);  // the voxels step by one each way
+  EXPECT_NEAR(tight->x2, 320 + 56, 2 * voxel_px);
+}
+
 // Each voxel keeps the mean of the depth points that fell in it: on a plane, the means lie on
 // the plane (to the storage's 1/65536 of a voxel) where the centres are up to half a voxel off;
 // fused models average their points by count.

@@ -3,7 +3,8 @@
 /// Object tracking of the paper ("Objects Tracking"): 2D association of map objects with a
 /// keyframe's detections, and 3D matching of the detections left over against the map.
 ///
-/// 2D: each map object's voxels are projected into the keyframe and give a box; the cost of
+/// 2D: each map object's voxels are projected into the keyframe and give a box (the mapper's
+/// objects in the map project only those near their ellipsoid); the cost of
 /// pairing object i with detection j is (eqs. 2-3, f read as a label mismatch cost)
 ///     cost(i, j) = lambda1 [label_i != label_j] + lambda2 (1 - IoU(box_i, box_j)),
 /// lambda1 >> lambda2, solved by the Hungarian method; a pair is kept only when its boxes

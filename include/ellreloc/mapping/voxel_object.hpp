@@ -19,6 +19,7 @@
 #include "ellreloc/core/box.hpp"
 #include "ellreloc/core/camera.hpp"
 #include "ellreloc/core/depth_image.hpp"
+#include "ellreloc/core/ellipsoid.hpp"
 #include "ellreloc/core/mask.hpp"
 
 namespace ellreloc {
@@ -97,8 +98,12 @@ class VoxelObject {
   /// reads: extents and yaw free of the grid's steps).
   std::vector<Eigen::Vector3d> occupiedPointMeans(std::optional<double> min_probability = std::nullopt) const;
   /// The box of the occupied voxels projected into a camera (clipped to the image), or nullopt
-  /// when fewer than `min_voxels` of them land in front of the camera inside the image.
-  std::optional<Box> projectedBox(const Intrinsics& K, const Pose& pose, int min_voxels = 10) const;
+  /// when fewer than `min_voxels` of them land in front of the camera inside the image. With
+  /// `within`, only the voxels inside that ellipsoid grown `within_scale` times count (2: the
+  /// corners of the cuboid an ellipsoid is inscribed in lie at sqrt(3)), so that stray voxels
+  /// far from the object's ellipsoid do not stretch its box.
+  std::optional<Box> projectedBox(const Intrinsics& K, const Pose& pose, int min_voxels = 10,
+                                  const Ellipsoid* within = nullptr, double within_scale = 2.0) const;
   /// Number of this object's occupied voxels that have an occupied voxel of `other` within
   /// `radius` metres (centre to centre): n(this, other) of the paper's eq. 4. Both objects
   /// must use the same voxel size.
