@@ -436,6 +436,12 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
           z >= depth_ranges[i].first - margin && z <= depth_ranges[i].second + margin;
   }
   const std::vector<int> tracked = associate2D(expected, detections, used, gate);
+  // An object 2D tracking paired with a detection is that detection's in this keyframe: a
+  // detector gives one box per object, so no other detection may join it by 3D matching (the
+  // detections are taken one at a time, and an earlier one would otherwise find it still free).
+  std::vector<char> paired(tracks_.size(), 0);
+  for (const int t : tracked)
+    if (t >= 0) paired[static_cast<size_t>(t)] = 1;
 
   for (size_t k = 0; k < used.size(); ++k) {
     const Detection& d = detections[used[k]];
@@ -458,8 +464,9 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     // Of several objects that pass it (neighbours of one label), the one that matches best.
     Track* match = nullptr;
     double best = options_.tracking.match_ratio;
-    for (Track& t : tracks_) {
-      if (t.last_seen == keyframes_ || t.label() != d.category_id) continue;
+    for (size_t i = 0; i < tracks_.size(); ++i) {
+      Track& t = tracks_[i];
+      if ((i < paired.size() && paired[i]) || t.last_seen == keyframes_ || t.label() != d.category_id) continue;
       const double strength = voxelMatchStrength(fresh, t.voxels, options_.tracking);
       if (strength > best) best = strength, match = &t;
     }

@@ -530,6 +530,42 @@ TEST(Mapper, ADetectionJoinsTheObjectItsVoxelsMatchBest) {
   }
 }
 
+// Voxel mode: an object that 2D tracking pairs with one detection of a keyframe takes no other
+// detection of it by 3D matching. Two small books side by side, 1 cm apart (each passes eq. 4
+// for the other); the left one is mapped alone, then both are detected, the right one with the
+// higher score, so it is taken first: its voxels match the left book's, which its own detection
+// will take by 2D tracking. The right book starts an object of its own.
+TEST(Mapper, ADetectionDoesNotJoinAnObjectAnotherDetectionOfItsKeyframeTracks) {
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const int kBook = 73;
+  const Eigen::Vector3d left(-0.035, 0.0, 2.0), right(0.035, 0.0, 2.0);
+  const std::vector<std::pair<Eigen::Vector3d, double>> squares{{left, 0.03}, {right, 0.03}};
+  MapperOptions options;
+  options.ellipsoid.up = -Eigen::Vector3d::UnitY();  // the cameras' image-up
+  Mapper mapper(K, options);
+  const auto add = [&](const std::vector<int>& detected) {
+    Squares frame = renderSquares(K, Eigen::Vector3d::Zero(), squares, detected, kBook);
+    for (size_t j = 0; j < detected.size(); ++j) frame.detections[j].score = detected[j] == 1 ? 0.9 : 0.6;
+    return mapper.addKeyframe(Pose(), frame.detections, &frame.depth);
+  };
+  const int left_id = add({0}).object_ids[0];
+  add({0});
+  add({0});
+  const KeyframeReport both = add({0, 1});
+  EXPECT_EQ(both.object_ids[0], left_id);
+  EXPECT_NE(both.object_ids[1], left_id);
+  EXPECT_EQ(both.matched_3d, 0);
+  add({0, 1});
+  add({0, 1});
+  const std::vector<MappedObject> objects = mapper.objects();
+  ASSERT_EQ(objects.size(), 2u);
+  for (const MappedObject& o : objects) {
+    const bool is_right = o.object.ellipsoid.center().x() > 0.0;
+    EXPECT_LT((o.object.ellipsoid.center() - (is_right ? right : left)).norm(), 0.015);
+    EXPECT_EQ(o.observations, is_right ? 3 : 6);
+  }
+}
+
 // The map records where its keyframes were taken: their heights and tilts along the world's up
 // when the mapper has one (voxel mode, or boxes mode given `boxes.up`), else along their mean
 // image-up, widened by 1 m and 30 degrees; none before two keyframes.
