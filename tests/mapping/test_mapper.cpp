@@ -502,6 +502,19 @@ TEST(Mapper, StrayVoxelsDoNotDrawADetectionToTheirObject) {
   ASSERT_EQ(mapper.objects().size(), 2u);
 }
 
+/// Two objects in the map, one at each book (the left one at negative x), with these counts of
+/// observations.
+void expectTwoBooks(const Mapper& mapper, const Eigen::Vector3d& left, const Eigen::Vector3d& right,
+                    int left_observations, int right_observations) {
+  const std::vector<MappedObject> objects = mapper.objects();
+  ASSERT_EQ(objects.size(), 2u);
+  for (const MappedObject& o : objects) {
+    const bool is_right = o.object.ellipsoid.center().x() > 0.0;
+    EXPECT_LT((o.object.ellipsoid.center() - (is_right ? right : left)).norm(), 0.015);
+    EXPECT_EQ(o.observations, is_right ? right_observations : left_observations);
+  }
+}
+
 // Voxel mode: a detection left over by 2D tracking joins the object its voxels match best, not
 // the first that passes eq. 4. Two small books side by side, 1 cm apart, both pass it for a
 // detection of the right one seen again after two keyframes without either; the left one was
@@ -521,13 +534,7 @@ TEST(Mapper, ADetectionJoinsTheObjectItsVoxelsMatchBest) {
     matched_3d += mapper.addKeyframe(Pose(), frame.detections, &frame.depth).matched_3d;
   }
   EXPECT_EQ(matched_3d, 1);
-  const std::vector<MappedObject> objects = mapper.objects();
-  ASSERT_EQ(objects.size(), 2u);
-  for (const MappedObject& o : objects) {
-    const bool is_right = o.object.ellipsoid.center().x() > 0.0;
-    EXPECT_LT((o.object.ellipsoid.center() - (is_right ? right : left)).norm(), 0.015);
-    EXPECT_EQ(o.observations, is_right ? 4 : 3);
-  }
+  expectTwoBooks(mapper, left, right, 3, 4);
 }
 
 // Voxel mode: an object that 2D tracking pairs with one detection of a keyframe takes no other
@@ -557,13 +564,7 @@ TEST(Mapper, ADetectionDoesNotJoinAnObjectAnotherDetectionOfItsKeyframeTracks) {
   EXPECT_EQ(both.matched_3d, 0);
   add({0, 1});
   add({0, 1});
-  const std::vector<MappedObject> objects = mapper.objects();
-  ASSERT_EQ(objects.size(), 2u);
-  for (const MappedObject& o : objects) {
-    const bool is_right = o.object.ellipsoid.center().x() > 0.0;
-    EXPECT_LT((o.object.ellipsoid.center() - (is_right ? right : left)).norm(), 0.015);
-    EXPECT_EQ(o.observations, is_right ? 3 : 6);
-  }
+  expectTwoBooks(mapper, left, right, 6, 3);
 }
 
 // The map records where its keyframes were taken: their heights and tilts along the world's up
