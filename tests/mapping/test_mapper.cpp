@@ -463,12 +463,13 @@ TEST(Mapper, ADetectionIsNotTrackedToAnObjectAtAnotherDepth) {
   EXPECT_EQ(objects[0].observations + objects[1].observations, 7);
 }
 
-// Voxel mode: an object is expected in a keyframe where its ellipsoid projects, not where stray
-// voxels put it. Two books side by side; in one keyframe the left one's mask bleeds onto a strip
-// of the right one (a segmentation error at the same depth), which the right one's detection
-// misses. The camera then moves right, so that the left book leaves the view and the right one
-// sits at its left edge: the strip's voxels still project there, over the right book's
-// detection, but the left book's ellipsoid does not, and the detection joins its own book.
+// Voxel mode: an object is expected in a keyframe where its voxels near its ellipsoid project,
+// not where stray voxels put it. Two books side by side; in one keyframe the left one's mask
+// bleeds onto a strip of the right one (a segmentation error at the same depth), which the right
+// one's detection misses. The camera then moves right, so that the left book leaves the view and
+// the right one sits at its left edge: the strip's voxels still project there, over the right
+// book's detection, but lie far outside the left book's ellipsoid, and the detection joins its
+// own book.
 TEST(Mapper, StrayVoxelsDoNotDrawADetectionToTheirObject) {
   const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   const int kBook = 73;
