@@ -387,13 +387,6 @@ void Mapper::rebuild(Track& track) const {
   track.built = m;
 }
 
-std::optional<Box> Mapper::expectedVoxelBox(const Track& track, const Pose& pose) const {
-  // An object's voxels near its ellipsoid, once it has one: a voxel model holds a few strays
-  // (mask pixels of a neighbour at the same depth), and a box that reaches them can draw the
-  // neighbour's detection to the object once the object itself has left the view.
-  return track.voxels.projectedBox(K_, pose, 10, track.built ? &track.built->object.ellipsoid : nullptr);
-}
-
 void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage& depth,
                               KeyframeReport* report) {
   // The keyframe's usable detections with their masks (a box stands in for a missing mask).
@@ -416,10 +409,14 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
   std::vector<std::pair<size_t, std::vector<Box>>> expected;
   std::vector<std::pair<double, double>> depth_ranges;
   for (size_t i = 0; i < tracks_.size(); ++i) {
-    if (keyframes_ - tracks_[i].last_seen > options_.track_window) continue;
-    if (const auto box = expectedVoxelBox(tracks_[i], pose)) {
+    const Track& t = tracks_[i];
+    if (keyframes_ - t.last_seen > options_.track_window) continue;
+    // An object in the map projects only its voxels near its ellipsoid: a voxel model holds a few
+    // strays (mask pixels of a neighbour at the same depth), and a box that reaches them can draw
+    // the neighbour's detection to the object once the object itself has left the view.
+    if (const auto box = t.voxels.projectedBox(K_, pose, 10, t.built ? &t.built->object.ellipsoid : nullptr)) {
       expected.emplace_back(i, std::vector<Box>{*box});
-      depth_ranges.push_back(depthRange(tracks_[i].voxels, pose));
+      depth_ranges.push_back(depthRange(t.voxels, pose));
     }
   }
   PairGate gate = PairGate::Constant(static_cast<long>(expected.size()), static_cast<long>(used.size()), true);

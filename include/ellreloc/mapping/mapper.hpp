@@ -196,9 +196,6 @@ class Mapper {
   /// when the boxes are the pinhole image's.
   void addBoxKeyframe(const Pose& pose, const std::vector<Detection>& detections, const std::vector<bool>& cut,
                       KeyframeReport* report);
-  /// Voxel mode: the box 2D tracking expects a track in, in a keyframe: its voxels' (those near
-  /// its ellipsoid once it has one), clipped to the image; nullopt when out of view.
-  std::optional<Box> expectedVoxelBox(const Track& track, const Pose& pose) const;
   void observed(Track& track, const Detection& detection);
   void mergeDuplicateBoxTracks();
   /// Pairs with an object updated in this keyframe (the others cannot have changed), or every
