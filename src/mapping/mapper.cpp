@@ -113,6 +113,16 @@ std::pair<double, double> depthRange(const VoxelObject& voxels, const Pose& pose
   return {quantile(z, 0.1, -inf), quantile(z, 0.9, inf)};
 }
 
+/// A voxel object's ellipsoid and cuboid moved by a rigid transform x -> R x + t.
+void moveRigidly(MappedObject& m, const Pose& motion) {
+  const Ellipsoid& e = m.object.ellipsoid;
+  m.object.ellipsoid = Ellipsoid(motion.transform(e.center()), e.axes(), motion.rotation() * e.rotation());
+  if (m.cuboid) {
+    m.cuboid->center = motion.transform(m.cuboid->center);
+    m.cuboid->rotation = motion.rotation() * m.cuboid->rotation;
+  }
+}
+
 }  // namespace
 
 const char* toString(MappingMode mode) { return mode == MappingMode::Voxel ? "voxel" : "boxes"; }
@@ -316,6 +326,9 @@ void Mapper::updateKeyframePoses(const std::vector<Pose>& poses) {
       const size_t anchor = static_cast<size_t>(t.last_seen);
       const Pose moved = poses[anchor].inverse() * keyframe_poses_[anchor];
       t.voxels.moveRigidly(moved.rotation(), moved.translation());
+      // The ellipsoid moves with its voxels, so that it is where they are even when the moved
+      // voxels no longer build one (rebuild then keeps it).
+      if (t.built) moveRigidly(*t.built, moved);
     }
     if (t.confirmed) rebuild(t);
   }

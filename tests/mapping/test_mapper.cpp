@@ -776,6 +776,57 @@ TEST(Mapper, AVoxelObjectFollowsTheCorrectionOfTheKeyframesThatSawItLast) {
     }
 }
 
+// A correction that turns the map: the voxels move with their last keyframe and, turned against
+// the grid, some fall into one cell. With an ellipsoid that needs every point it was built from,
+// the moved voxels build none, and the ellipsoid they had moves with them instead of staying
+// where the drifted keyframes put it.
+TEST(Mapper, AVoxelObjectThatCannotBeRebuiltAfterACorrectionMovesWithItsVoxels) {
+  const sim::Scene scene = oneBoxScene();
+  const sim::SimObject& box = scene.objects[0];
+  const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
+  const Pose drift(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                   Eigen::Vector3d(0.3, -0.2, 0.0));
+  std::mt19937_64 rng(1);
+  std::vector<Pose> poses;
+  std::vector<std::vector<Detection>> detections;
+  std::vector<DepthImage> depths;
+  for (int i = 0; i < 4; ++i) {
+    const double a = -0.2 + 0.15 * i;
+    poses.push_back(Pose::lookAt(Eigen::Vector3d(2.0 * std::cos(a), 2.0 * std::sin(a), 1.2), box.box_center));
+    const sim::RenderedFrame frame = sim::render(scene, K, poses.back());
+    depths.push_back(sim::noisyDepth(frame, sim::NoiseModel(), rng));
+    detections.push_back(sim::detect(scene, frame, sim::NoiseModel(), rng));
+  }
+  const auto drifted = [&](size_t min_points) {
+    MapperOptions opt;
+    opt.ellipsoid.min_points = min_points;
+    auto mapper = std::make_unique<Mapper>(K, opt);
+    for (size_t i = 0; i < poses.size(); ++i) mapper->addKeyframe(poses[i] * drift, detections[i], &depths[i]);
+    return mapper;
+  };
+  // The most points the object had when its ellipsoid was built.
+  size_t lo = 8, hi = drifted(8)->objects().at(0).voxels + 1;
+  while (hi - lo > 1) {
+    const size_t mid = (lo + hi) / 2;
+    (drifted(mid)->map().objects.empty() ? hi : lo) = mid;
+  }
+  const auto mapper = drifted(lo);
+  const auto off = [&] { return (mapper->map().objects.at(0).ellipsoid.center() - box.box_center).norm(); };
+  ASSERT_EQ(mapper->map().objects.size(), 1u);
+  EXPECT_GT(off(), 0.2) << off();
+  const size_t voxels = mapper->objects().at(0).voxels;
+  const Ellipsoid before = mapper->map().objects.at(0).ellipsoid;
+  mapper->updateKeyframePoses(poses);
+  ASSERT_EQ(mapper->map().objects.size(), 1u);
+  EXPECT_EQ(mapper->objects().at(0).voxels, voxels);  // not rebuilt: its voxel count is the old one
+  EXPECT_LT(off(), 0.05) << off();                    // a box seen from one side: its ellipsoid a few cm deep
+  // Moved as a whole: every keyframe's correction is `drift`.
+  const Ellipsoid after = mapper->map().objects.at(0).ellipsoid;
+  EXPECT_LT((after.center() - drift.transform(before.center())).norm(), 1e-9);
+  const Eigen::Matrix3d turned = drift.rotation() * before.shapeMatrix() * drift.rotation().transpose();
+  EXPECT_LT((after.shapeMatrix() - turned).norm(), 1e-9);
+}
+
 // A loop: the camera maps a book from an arc (keyframes 0-7), looks away (8-11), and comes back
 // along the arc with its poses drifted by 40 cm, so the book's boxes fall where the map holds
 // nothing and a second book is made there. Once the host closes the loop (the true poses), both
