@@ -60,26 +60,32 @@ Synthetic makeSceneSeeing(std::mt19937& rng, size_t min_observations, int n, int
 
 }  // namespace
 
+// With every sampler: Auto (the default), every triplet, random triplets, PROSAC.
 TEST(ObjectRelocalizer, RecoversThePoseAndTheCorrespondences) {
-  std::mt19937 rng(81);
   const Intrinsics K = test::testIntrinsics();
-  int tried = 0, recovered = 0;
-  for (int trial = 0; trial < 40; ++trial) {
-    const Synthetic s = makeScene(rng, 12, 6, 0.5);
-    if (s.observations.size() < 4) continue;
-    ++tried;
-    const ObjectRelocalizer reloc(s.map, K);
-    const RelocalizationResult r = reloc.relocalize(s.observations);
-    ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
-    // 0.5 px of centre noise on ellipses of 10-50 px: about 1 cm and 0.2 degrees.
-    if (positionError(r.pose, s.truth) < 0.05 && rotationErrorDeg(r.pose.rotation(), s.truth.rotation()) < 1.0) {
-      ++recovered;
-      for (const ObjectCorrespondence& c : r.inliers) EXPECT_EQ(c.object, s.object_of[c.observation]);
-      EXPECT_GE(r.inliers.size(), s.observations.size() - 1);
+  for (const HypothesisSampler sampler : {HypothesisSampler::Auto, HypothesisSampler::Exhaustive,
+                                          HypothesisSampler::Uniform, HypothesisSampler::Prosac}) {
+    RelocalizerOptions options;
+    options.search.sampler = sampler;
+    std::mt19937 rng(81);
+    int tried = 0, recovered = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+      const Synthetic s = makeScene(rng, 12, 6, 0.5);
+      if (s.observations.size() < 4) continue;
+      ++tried;
+      const ObjectRelocalizer reloc(s.map, K, options);
+      const RelocalizationResult r = reloc.relocalize(s.observations);
+      ASSERT_EQ(r.status, RelocalizationStatus::Success) << r.reason;
+      // 0.5 px of centre noise on ellipses of 10-50 px: about 1 cm and 0.2 degrees.
+      if (positionError(r.pose, s.truth) < 0.05 && rotationErrorDeg(r.pose.rotation(), s.truth.rotation()) < 1.0) {
+        ++recovered;
+        for (const ObjectCorrespondence& c : r.inliers) EXPECT_EQ(c.object, s.object_of[c.observation]);
+        EXPECT_GE(r.inliers.size(), s.observations.size() - 1);
+      }
     }
+    EXPECT_GE(tried, 30);
+    EXPECT_GE(recovered, tried - 1) << static_cast<int>(sampler);
   }
-  EXPECT_GE(tried, 30);
-  EXPECT_GE(recovered, tried - 1);
 }
 
 // A partly hidden object's mask shows only its visible part, so its ellipse is smaller than

@@ -192,6 +192,14 @@ TEST(WassersteinRefiner, DegenerateInputIsHandled) {
   EXPECT_FALSE(r.fell_back);
   EXPECT_LE(r.final_cost, r.initial_cost);
   for (const auto& mm : near) EXPECT_TRUE(project(mm.ellipsoid, K, r.pose).ok());
+  // A matched point behind the camera at the initial pose: no cost to start from, the initial
+  // pose comes back, and the point's residual says it does not project.
+  const std::vector<PointMatch> behind_point = {{Eigen::Vector2d(320, 240), s.truth.inverse().transform({0, 0, -1})}};
+  const RefinementResult bp = refinePose(K, s.truth, s.matches, behind_point);
+  EXPECT_TRUE(bp.fell_back);
+  EXPECT_NE(bp.message.find("cost not finite"), std::string::npos) << bp.message;
+  EXPECT_TRUE(bp.pose.translation().isApprox(s.truth.translation()));
+  EXPECT_EQ(bp.point_residuals, std::vector<double>{-1.0});
   // Invalid observation (NaN): skipped, reported as -1.
   std::vector<EllipseMatch> bad = s.matches;
   bad.push_back({Ellipse({std::nan(""), 1}, {1, 1}, 0), s.matches[0].ellipsoid});
