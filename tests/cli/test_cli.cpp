@@ -347,6 +347,32 @@ TEST(Cli, Fr2DeskKeyframesMappedFromUndistortedBoxes) {
   EXPECT_GT(undistorted, raw + 0.01);
 }
 
+// A method's label is the user's text: escaped in the SVG plot, quoted in the per-frame CSV
+// (the keyframe poses evaluated against themselves: every frame valid).
+TEST(Cli, EvaluateLabelsAreEscapedInTheSvgAndQuotedInTheCsv) {
+  ellreloc::test::TempDir dir;
+  const std::string d = data("tum_fr2_desk");
+  const CliRun r =
+      run("evaluate --groundtruth " + d + "/keyframes.groundtruth.txt --estimate '" + d +
+              "/keyframes.groundtruth.txt:A&B <\"x\">, y' --detections " + d + "/keyframes.detections.json --plot " +
+              dir.path("plot.svg") + " --per-frame " + dir.path("frames.csv"),
+          dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string svg = readFile(dir.path("plot.svg"));
+  EXPECT_NE(svg.find("A&amp;B &lt;&quot;x&quot;&gt;, y"), std::string::npos);
+  EXPECT_EQ(svg.find("A&B"), std::string::npos);
+  std::istringstream csv(readFile(dir.path("frames.csv")));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "frame,method,status,position_cm,rotation_deg");
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    EXPECT_NE(line.find(",\"A&B <\"\"x\"\">, y\",valid,0.000,0.000"), std::string::npos) << line;
+  }
+  EXPECT_EQ(rows, 198);
+}
+
 // For a host that checks poses with its points: the report lists the other answers found, and on
 // the fr2_desk keyframes one of them is valid where the pose is not in a few frames (measured,
 // every pose reported: the pose 138, the pose or the rival 147, the pose or an alternative 151).
@@ -653,6 +679,8 @@ TEST(Cli, BadInputGivesExitCodeTwoOneLineAndNoOutputFile) {
                          "/map.json --detections " + d + "/keyframes.detections.json"},
       {"unknown method",
        reloc + "--map " + d + "/map.json --detections " + d + "/keyframes.detections.json --method x"},
+      {"unknown observation policy", "observe --camera " + d + "/camera.yaml --detections " + d +
+                                         "/keyframes.detections.json --policy x --out " + out},
       {"unknown subcommand", "teleport --out " + out},
       {"missing option", "relocalize --camera " + d + "/camera.yaml --out " + out},
       {"bad thread count",

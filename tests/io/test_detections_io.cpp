@@ -154,21 +154,44 @@ TEST(DetectionsIo, MalformedFilesNameTheField) {
       {"[{\"file_name\": \"\", \"detections\": []}]", "[0].file_name: expected a non-empty string"},
       {"[{\"file_name\": \"a.png\", \"detections\": {}}]", "[0].detections: expected an array"},
       {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": 41}]}]", "[0].detections[0].bbox: missing"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": 41, \"bbox\": [1, 2, 3]}]}]", "bbox: expected an array of 4"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": 41, \"bbox\": [10, 2, 3, 40]}]}]", "bbox: expected [x1, y1, x2, y2] with x1 < x2"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": \"cup\", \"bbox\": [1, 2, 3, 4]}]}]", "category_id: expected an integer"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"detection_score\": -1}]}]", "detection_score: must be >= 0"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"size\": [4, 4], \"counts\": [3, 20]}}]}]", "mask.counts: runs sum to 23, expected height x width = 16"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"size\": [4, 4], \"counts\": [3, -2, 15]}}]}]", "mask.counts[1]: run lengths must be >= 0"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"size\": [4, 4], \"counts\": \"P\"}}]}]", "mask.counts: malformed compressed RLE string"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"size\": [0, 4], \"counts\": []}}]}]", "mask.size: height and width must be positive"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"counts\": []}}]}]", "mask.size: missing"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"polygon\": [[1, 2], [3, 4]]}]}]", "polygon: expected at least 3"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + R"(, "ellipse": {"center": [1, 2], "axes": [0, 2], "angle": 0}}]}])", "ellipse.axes: semi-axes must be positive"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + R"(, "ellipse": {"center": [1, 2], "axes": [1, 2]}}]}])", "ellipse.angle: missing"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [], \"keypoints\": [[1, 2]]}]", "[0].keypoints[0]: expected [point_index, u, v]"},
-      {"[{\"file_name\": \"a.png\", \"detections\": [], \"keypoints\": [[-1, 2, 3]]}]", "[0].keypoints[0][0]: point index must be >= 0"},
-      {"[{\"file_name\": \"a.png\", \"detections\": []}, {\"file_name\": \"a.png\", \"detections\": []}]", "[1].file_name: 'a.png' repeats frame [0]"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": 41, \"bbox\": [1, 2, 3]}]}]",
+       "bbox: expected an array of 4"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": 41, \"bbox\": [10, 2, 3, 40]}]}]",
+       "bbox: expected [x1, y1, x2, y2] with x1 < x2"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": \"cup\", \"bbox\": [1, 2, 3, 4]}]}]",
+       "category_id: expected an integer"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{\"category_id\": 7.5, \"bbox\": [1, 2, 3, 4]}]}]",
+       "category_id: expected an integer, got 7.5"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"size\": [4, 4], \"counts\": 16}}]}]",
+       "mask.counts: expected a compressed RLE string or a list of run lengths"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"detection_score\": -1}]}]",
+       "detection_score: must be >= 0"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box +
+           ", \"mask\": {\"size\": [4, 4], \"counts\": [3, 20]}}]}]",
+       "mask.counts: runs sum to 23, expected height x width = 16"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box +
+           ", \"mask\": {\"size\": [4, 4], \"counts\": [3, -2, 15]}}]}]",
+       "mask.counts[1]: run lengths must be >= 0"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"size\": [4, 4], \"counts\": \"P\"}}]}]",
+       "mask.counts: malformed compressed RLE string"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"size\": [0, 4], \"counts\": []}}]}]",
+       "mask.size: height and width must be positive"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"mask\": {\"counts\": []}}]}]",
+       "mask.size: missing"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box + ", \"polygon\": [[1, 2], [3, 4]]}]}]",
+       "polygon: expected at least 3"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box +
+           R"(, "ellipse": {"center": [1, 2], "axes": [0, 2], "angle": 0}}]}])",
+       "ellipse.axes: semi-axes must be positive"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [{" + box +
+           R"(, "ellipse": {"center": [1, 2], "axes": [1, 2]}}]}])",
+       "ellipse.angle: missing"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [], \"keypoints\": [[1, 2]]}]",
+       "[0].keypoints[0]: expected [point_index, u, v]"},
+      {"[{\"file_name\": \"a.png\", \"detections\": [], \"keypoints\": [[-1, 2, 3]]}]",
+       "[0].keypoints[0][0]: point index must be >= 0"},
+      {"[{\"file_name\": \"a.png\", \"detections\": []}, {\"file_name\": \"a.png\", \"detections\": []}]",
+       "[1].file_name: 'a.png' repeats frame [0]"},
   };
   test::TempDir dir;
   int n = 0;
@@ -183,6 +206,18 @@ TEST(DetectionsIo, MalformedFilesNameTheField) {
       EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u) << e.what();
     }
   }
+}
+
+// Some writers emit integers as floats: 7.0 is read as 7 (7.5 is refused, above).
+TEST(DetectionsIo, IntegersWrittenAsWholeFloatsAreRead) {
+  test::TempDir dir;
+  const std::string path = dir.path("floats.json");
+  io::writeFileAtomically(path,
+                          R"([{"file_name": "a.png", "detections": [{"category_id": 7.0, "bbox": [1, 2, 3, 4]}]}])");
+  const std::vector<DetectionFrame> frames = io::readDetections(path);
+  ASSERT_EQ(frames.size(), 1u);
+  ASSERT_EQ(frames[0].detections.size(), 1u);
+  EXPECT_EQ(frames[0].detections[0].category_id, 7);
 }
 
 // The data's README: median IoU between each associated box and the (image-clipped) bounding

@@ -176,6 +176,8 @@ TEST(MapIo, MalformedMapsNameTheFileAndField) {
        "objects[0].rotation"},
       {R"({"objects": [{"id": "a", "category": 41}]})", "objects[0].id: expected an integer"},
       {R"({"objects": [{"id": 1, "category": 41.5}]})", "objects[0].category: expected an integer"},
+      {"{\"objects\": [" + obj.substr(0, obj.size() - 1) + R"(, "category_counts": {"cup": 3}}]})",
+       "objects[0].category_counts.cup: key is not an integer category"},
       {R"({"objects": [{"id": 1, "category": 41, "center": [0, "x", 1], "axes": [1,1,1], "rotation": [[1,0,0],[0,1,0],[0,0,1]]}]})",
        "objects[0].center[1]: expected a number"},
       {R"({"objects": [{"id": 1, "category": 41, "dual_quadric": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]})",
