@@ -332,8 +332,8 @@ TEST(Cli, Fr2DeskKeyframesMappedFromUndistortedBoxes) {
   const std::string d = data("tum_fr2_desk");
   const auto heldOutIoU = [&](const std::string& extra) {
     const CliRun r =
-        run("map --camera " + d + "/camera.yaml --trajectory " + d + "/keyframes.groundtruth.txt" + " --detections " +
-                d + "/keyframes.detections.json --mode boxes --holdout-every 2 --out " + dir.path("map.json") + extra,
+        run("map --camera " + d + "/camera.yaml --trajectory " + d + "/keyframes.groundtruth.txt --detections " + d +
+                "/keyframes.detections.json --mode boxes --holdout-every 2 --out " + dir.path("map.json") + extra,
             dir);
     EXPECT_EQ(r.code, 0) << r.err;
     std::smatch m;
@@ -532,17 +532,17 @@ TEST(Cli, Fr3CabinetUprightWithTheHostsUpAndScoredOnFramesLeftOut) {
   const std::string d = data("tum_fr3_cabinet");
   const std::string common = "map --camera " + d + "/camera.yaml --associations " + d + "/associate.txt --trajectory " +
                              d + "/groundtruth.txt --detections " + d + "/detections.json --mode boxes --out ";
-  CliRun r = run(common + dir.path("free.json"), dir);
+  CliRun r = run(common + dir.path("fitted.json"), dir);
   ASSERT_EQ(r.code, 0) << r.err;
   r = run(common + dir.path("upright.json") + " --up 0,0,1 --holdout-every 5", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find(": 1 object from 47 keyframes"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("map quality on 11 held-out frames"), std::string::npos) << r.out;
-  const ellreloc::ObjectMap free = ellreloc::io::readMap(dir.path("free.json"));
+  const ellreloc::ObjectMap fitted = ellreloc::io::readMap(dir.path("fitted.json"));
   const ellreloc::ObjectMap upright = ellreloc::io::readMap(dir.path("upright.json"));
-  ASSERT_EQ(free.objects.size(), 1u);
+  ASSERT_EQ(fitted.objects.size(), 1u);
   ASSERT_EQ(upright.objects.size(), 1u);
-  EXPECT_GT(tiltFrom(free.objects[0].ellipsoid, Eigen::Vector3d::UnitZ()), 2.0);
+  EXPECT_GT(tiltFrom(fitted.objects[0].ellipsoid, Eigen::Vector3d::UnitZ()), 2.0);
   EXPECT_LT(tiltFrom(upright.objects[0].ellipsoid, Eigen::Vector3d::UnitZ()), 1e-4);
 }
 
