@@ -128,6 +128,34 @@ def test_a_track_gives_the_command_lines_track_poses(fr2, data_dir, cli, tmp_pat
         E.TrackRelocalizer(relocalizer, max_frames=0)
 
 
+def test_a_frame_without_odometry_starts_the_track_again(fr2, data_dir, cli, tmp_path):
+    """Every 40th keyframe without an odometry pose: `--track` relocalizes it alone and starts the
+    track again after it, as a TrackRelocalizer reset there does, and says how many."""
+    camera, map_, frames = fr2
+    d = data_dir / "tum_fr2_desk"
+    truth = E.read_trajectory(d / "keyframes.groundtruth.txt")
+    E.write_trajectory(tmp_path / "odometry.txt", [(s.stamp, s.pose) for k, s in enumerate(truth) if k % 40 != 20])
+    printed = subprocess.run([cli, "relocalize", "--camera", str(d / "camera.yaml"), "--map", str(d / "map.json"),
+                              "--detections", str(d / "keyframes.detections.json"), "--track",
+                              str(tmp_path / "odometry.txt"), "--track-frames", "4", "--out", str(tmp_path / "cli.txt")],
+                             check=True, capture_output=True, text=True).stdout
+    relocalizer = E.ObjectRelocalizer(map_, camera)
+    track = E.TrackRelocalizer(relocalizer, max_frames=4)
+    odometry = E.read_trajectory(tmp_path / "odometry.txt")
+    results, alone = [], 0
+    for f in frames:  # the keyframes are in timestamp order
+        k = E.find_nearest(odometry, f.timestamp)
+        if k is None:
+            alone += 1
+            track.reset()
+            results.append(relocalizer.relocalize(f))
+        else:
+            results.append(track.add(f, odometry[k].pose).result)
+    assert alone == 5
+    assert "5 frame(s) without a pose of" in printed, printed
+    assert python_trajectory(tmp_path / "python.txt", frames, results) == (tmp_path / "cli.txt").read_bytes()
+
+
 def test_a_track_finds_the_scale_of_a_monocular_odometry(fr2, data_dir, cli, tmp_path):
     """The same track with the odometry in units of 0.37 m, as a monocular SLAM map has them:
     Python and `--track-scale-unknown` give the same poses, the track finds the unit, and it
