@@ -321,14 +321,15 @@ void Mapper::updateKeyframePoses(const std::vector<Pose>& poses) {
   for (Track& t : tracks_) {
     if (options_.mode == MappingMode::Boxes) {
       for (size_t k = 0; k < t.views.size(); ++k) t.views[k].pose = poses[static_cast<size_t>(t.view_keyframes[k])];
-    } else if (t.last_seen >= 0) {
-      // A point that keyframe saw keeps its place in that camera's frame.
-      const size_t anchor = static_cast<size_t>(t.last_seen);
-      const Pose moved = poses[anchor].inverse() * keyframe_poses_[anchor];
-      t.voxels.moveRigidly(moved.rotation(), moved.translation());
-      // The ellipsoid moves with its voxels, so that it is where they are even when the moved
-      // voxels no longer build one (rebuild then keeps it).
-      if (t.built) moveRigidly(*t.built, moved);
+    } else if (!t.integrations.empty()) {
+      // A point keeps its place in the camera frame of the keyframe that last saw it there.
+      std::vector<Pose> motions;
+      for (const int k : t.integrations)
+        motions.push_back(poses[static_cast<size_t>(k)].inverse() * keyframe_poses_[static_cast<size_t>(k)]);
+      t.voxels.moveWithKeyframes(motions);
+      // The ellipsoid moves with the latest keyframe's voxels, so that it is where they are even
+      // when the moved voxels no longer build one (rebuild then keeps it).
+      if (t.built) moveRigidly(*t.built, motions.back());
     }
     if (t.confirmed) rebuild(t);
   }
@@ -459,6 +460,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     if (tracked[k] >= 0) {
       Track& t = tracks_[static_cast<size_t>(tracked[k])];
       t.voxels.integrate(K_, pose, depth, masks[k]);
+      t.integrations.push_back(keyframes_);
       observed(t, d);
       ++report->tracked_2d;
       report->object_ids[used[k]] = t.id;
@@ -482,6 +484,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     }
     if (match != nullptr) {
       match->voxels.integrate(K_, pose, depth, masks[k]);
+      match->integrations.push_back(keyframes_);
       observed(*match, d);
       ++report->matched_3d;
       report->object_ids[used[k]] = match->id;
@@ -490,6 +493,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     Track t;
     t.id = next_id_++;
     t.voxels = std::move(fresh);
+    t.integrations = {keyframes_};
     tracks_.push_back(std::move(t));
     observed(tracks_.back(), d);
     ++report->new_objects;

@@ -231,7 +231,6 @@ VoxelUpdate VoxelObject::integrate(const Intrinsics& K, const Pose& pose, const 
     const bool in_free_space = x_c.z() < d - options_.depth_tolerance;
     const bool seen_outside_mask = !inMask(mask, u, w) && !hidden;
     if (!seen_outside_mask && !in_free_space) continue;
-    v.stamp = frames_;
     v.log_odds = std::max(l_min, v.log_odds + l_miss);
     ++update.misses;
   }
@@ -276,12 +275,15 @@ void VoxelObject::absorb(const VoxelObject& other) {
     Voxel& v = voxels_[indexOrAdd(other.keys_[i], &added)];
     v.log_odds = std::clamp(v.log_odds + theirs.log_odds, l_min, l_max);
     addToMean(v, Eigen::Vector3d(theirs.mean[0], theirs.mean[1], theirs.mean[2]) / kMeanUnits, theirs.points);
-    v.stamp = frames_;  // counts as touched by this object's latest keyframe, not by a future one
+    v.stamp = frames_;  // counts as hit by this object's latest keyframe, not by a future one
   }
   enforceBudget();
 }
 
-void VoxelObject::moveRigidly(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+void VoxelObject::moveRigidly(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) { moveWithKeyframes({Pose(R, t)}); }
+
+void VoxelObject::moveWithKeyframes(const std::vector<Pose>& motions) {
+  if (motions.empty()) return;
   std::vector<uint64_t> old_keys;
   std::vector<Voxel> old_voxels;
   old_keys.swap(keys_);
@@ -289,7 +291,8 @@ void VoxelObject::moveRigidly(const Eigen::Matrix3d& R, const Eigen::Vector3d& t
   slots_.clear();
   for (size_t i = 0; i < old_keys.size(); ++i) {
     const Voxel& before = old_voxels[i];
-    const Eigen::Vector3d x = R * pointMeanOf(old_keys[i], before) + t;
+    const size_t k = std::clamp<size_t>(before.stamp, 1, motions.size());
+    const Eigen::Vector3d x = motions[k - 1].transform(pointMeanOf(old_keys[i], before));
     const std::optional<uint64_t> key = keyOf(x);
     if (!key) continue;
     bool added = false;

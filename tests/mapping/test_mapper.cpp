@@ -715,7 +715,7 @@ TEST(Mapper, ABoxMapFollowsALoopClosure) {
   EXPECT_LE(drifted, corrected / 2);
 }
 
-// Voxel mode keeps no depth image: each object moves with the keyframe that saw it last. With
+// Voxel mode keeps no depth image: each voxel moves with the keyframe that last hit it. With
 // every pose moved by one rigid transform, that brings each object where the map made in this
 // frame has it (to a voxel: the grids differ), and the up measured on the floor with it.
 TEST(Mapper, VoxelObjectsMoveWithTheKeyframeThatSawThemLast) {
@@ -741,16 +741,19 @@ TEST(Mapper, VoxelObjectsMoveWithTheKeyframeThatSawThemLast) {
 }
 
 // A drift over part of the trajectory, corrected: a box on the floor seen from 12 keyframes on an
-// arc, half of them drifted by 6 or 10 cm. The later keyframes' misses carve away what the
-// earlier ones placed elsewhere, so the object is where the latest keyframes put it: drifted
-// late, it lies off by nearly the drift until the correction moves it with its last keyframe;
-// drifted early, it lies right, and the correction (the last keyframe's: none) leaves it there.
+// arc, half of them drifted by 3, 6 or 10 cm. Each voxel moves with the keyframe that last hit
+// it, so what the undrifted keyframes placed stays and what the drifted ones placed is brought
+// back: 0.4 cm off afterwards in every case (measured). Before the correction, drifted late by
+// 6 / 10 cm the box lies 5.4 / 9.5 cm off (the later keyframes' misses carve away what the
+// earlier ones placed); by 3 cm, within the voxels' 4 cm depth tolerance, 0.9 cm (carved in part:
+// both placements remain, which moving the whole object with its last keyframe overcorrected to
+// 2.2 cm). Drifted early: 0.4-0.7 cm off before and after.
 TEST(Mapper, AVoxelObjectFollowsTheCorrectionOfTheKeyframesThatSawItLast) {
   const sim::Scene scene = oneBoxScene();
   const sim::SimObject& box = scene.objects[0];
   const Intrinsics K(525.0, 525.0, 319.5, 239.5, 640, 480);
   for (const bool late : {true, false})
-    for (const double d : {0.06, 0.1}) {
+    for (const double d : {0.03, 0.06, 0.1}) {
       const Pose drift(Eigen::Matrix3d::Identity(), Eigen::Vector3d(d, 0.0, 0.0));
       Mapper mapper(K);
       std::mt19937_64 rng(1);
@@ -766,7 +769,7 @@ TEST(Mapper, AVoxelObjectFollowsTheCorrectionOfTheKeyframesThatSawItLast) {
       }
       const auto off = [&] { return (mapper.map().objects.at(0).ellipsoid.center() - box.box_center).norm(); };
       ASSERT_EQ(mapper.map().objects.size(), 1u);
-      if (late)
+      if (late && d > 0.05)
         EXPECT_GT(off(), 0.8 * d) << d;
       else
         EXPECT_LT(off(), 0.01) << d;
@@ -776,7 +779,7 @@ TEST(Mapper, AVoxelObjectFollowsTheCorrectionOfTheKeyframesThatSawItLast) {
     }
 }
 
-// A correction that turns the map: the voxels move with their last keyframe and, turned against
+// A correction that turns the map: the voxels move with their keyframes and, turned against
 // the grid, some fall into one cell. With an ellipsoid that needs every point it was built from,
 // the moved voxels build none, and the ellipsoid they had moves with them instead of staying
 // where the drifted keyframes put it.

@@ -218,6 +218,36 @@ TEST(VoxelObject, MovedRigidlyTheVoxelsFollowTheirPoints) {
   }
 }
 
+// Each voxel moves with the keyframe that last hit it: a plane's left part hit by both
+// keyframes, its right part by the first only (the second misses it, outside its mask).
+TEST(VoxelObject, MovedWithTheirKeyframesEachVoxelFollowsTheKeyframeThatLastHitIt) {
+  VoxelObject v;
+  const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
+  v.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 390, 300));
+  v.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 320, 300));
+  const auto surfacePoint = [&](double u, double v_px) {
+    return camera.inverse().transform(Eigen::Vector3d((u - kVoxelCamera.cx) / kVoxelCamera.fx * 2.5,
+                                                      (v_px - kVoxelCamera.cy) / kVoxelCamera.fy * 2.5, 2.5));
+  };
+  const Eigen::Vector3d left = surfacePoint(260, 250), right = surfacePoint(380, 250);
+  const Pose first(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 1)),
+      second(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 0, 0));
+  VoxelObject each = v;
+  each.moveWithKeyframes({first, second});
+  EXPECT_NEAR(each.probabilityAt(first.transform(right)), bayes(0.7, 0.3), 1e-6);
+  EXPECT_NEAR(each.probabilityAt(second.transform(left)), bayes(0.7, 0.7), 1e-6);
+  EXPECT_EQ(each.probabilityAt(second.transform(right)), 0.5);  // nothing there: the prior
+  EXPECT_EQ(each.probabilityAt(first.transform(left)), 0.5);
+  EXPECT_EQ(each.size(), v.size());  // translations by whole metres: no two voxels meet
+  // One motion for all, as moveRigidly; none, nothing moves.
+  VoxelObject all = v, rigid = v, still = v;
+  all.moveWithKeyframes({first});
+  rigid.moveRigidly(first.rotation(), first.translation());
+  EXPECT_EQ(all.occupiedPointMeans(0.01), rigid.occupiedPointMeans(0.01));
+  still.moveWithKeyframes({});
+  EXPECT_EQ(still.occupiedPointMeans(0.01), v.occupiedPointMeans(0.01));
+}
+
 TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {
   const Pose camera;
   const BinaryMask full = rectMask(300, 220, 340, 260);

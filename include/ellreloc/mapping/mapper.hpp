@@ -175,6 +175,7 @@ class Mapper {
     VoxelObject voxels;
     std::vector<BoxView> views;       // boxes mode
     std::vector<int> view_keyframes;  // boxes mode: the keyframe of each view
+    std::vector<int> integrations;    // voxel mode: the keyframe of each integrate() into `voxels`
     std::map<int, double> labels;
     int observations = 0;
     int last_seen = -1;

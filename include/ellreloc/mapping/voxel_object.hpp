@@ -85,6 +85,13 @@ class VoxelObject {
   /// Voxels moved beyond the grid's range (about 10 km from the origin at 1 cm) are dropped.
   void moveRigidly(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
 
+  /// Moves each voxel with the keyframe that last hit it, as moveRigidly moves them all:
+  /// `motions[k - 1]` (x -> R x + t, a Pose's transform) for the voxels whose last hit came
+  /// from the k-th integrate() (absorbed voxels count as hit by the latest; past the end of
+  /// `motions`, its last). A host that corrects its keyframes by different amounts moves what
+  /// each keyframe placed with that keyframe. No motions: nothing moves.
+  void moveWithKeyframes(const std::vector<Pose>& motions);
+
   /// Number of voxels held (any probability).
   size_t size() const { return voxels_.size(); }
   /// Number of voxels at or above options().occupied_probability.
@@ -121,7 +128,7 @@ class VoxelObject {
  private:
   struct Voxel {
     float log_odds = 0.0f;
-    uint32_t stamp = 0;  ///< the keyframe that last touched it (one update per keyframe)
+    uint32_t stamp = 0;  ///< the integrate() that last hit it, counted from 1 (one hit per keyframe)
     /// The mean of the depth points that fell in it, from its centre, in 1/65536 of a voxel
     /// (a voxel spans [-32768, 32768)); `points` of them, counted up to 65535 (later points
     /// then move the mean by 1/65535 of their offset each).
