@@ -136,8 +136,8 @@ class Mapper {
   /// world->camera pose of every keyframe added so far, in the order they were added. Boxes
   /// mode: every object is fitted again to its boxes, each seen from its keyframe's new pose (as
   /// finish() does, so the map is what these poses would have made of the same associations).
-  /// Voxel mode: the depth images are gone, so each object moves rigidly with the keyframe that
-  /// saw it last (its voxels go where that keyframe's camera now puts them); the up estimated
+  /// Voxel mode: the depth images are gone, so each voxel moves with the keyframe that last hit
+  /// it (it goes where that keyframe's camera now puts it); the up estimated
   /// from the floor is measured again from each keyframe's floor at its new pose. Objects that
   /// now coincide are joined as while mapping (two tracks of one object that a drift split before
   /// a loop closed). The camera envelope follows the new poses. Throws ellreloc::Error naming the
