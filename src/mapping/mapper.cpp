@@ -318,14 +318,17 @@ void Mapper::updateKeyframePoses(const std::vector<Pose>& poses) {
     for (const auto& [keyframe, normal] : floor_in_camera_)
       floor_normal_sum_ += poses[static_cast<size_t>(keyframe)].rotation().transpose() * normal;
   }
+  // Voxel mode: a point keeps its place in the camera frame of the keyframe that last saw it
+  // there, so it moves by that keyframe's correction.
+  std::vector<Pose> corrections;
+  if (options_.mode == MappingMode::Voxel)
+    for (size_t k = 0; k < poses.size(); ++k) corrections.push_back(poses[k].inverse() * keyframe_poses_[k]);
   for (Track& t : tracks_) {
     if (options_.mode == MappingMode::Boxes) {
       for (size_t k = 0; k < t.views.size(); ++k) t.views[k].pose = poses[static_cast<size_t>(t.view_keyframes[k])];
     } else if (!t.integrations.empty()) {
-      // A point keeps its place in the camera frame of the keyframe that last saw it there.
       std::vector<Pose> motions;
-      for (const int k : t.integrations)
-        motions.push_back(poses[static_cast<size_t>(k)].inverse() * keyframe_poses_[static_cast<size_t>(k)]);
+      for (const int k : t.integrations) motions.push_back(corrections[static_cast<size_t>(k)]);
       t.voxels.moveWithKeyframes(motions);
       // The ellipsoid moves with the latest keyframe's voxels, so that it is where they are even
       // when the moved voxels no longer build one (rebuild then keeps it).

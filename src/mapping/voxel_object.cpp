@@ -347,15 +347,12 @@ Eigen::AlignedBox3d VoxelObject::bounds() const {
 std::optional<Box> VoxelObject::projectedBox(const Intrinsics& K, const Pose& pose, int min_voxels,
                                              const Ellipsoid* within, double within_scale) const {
   if (!K.isValid() || !pose.isValid()) return std::nullopt;
-  // Inside `within` grown: |diag(1 / (scale axes)) R^T (x - c)| <= 1.
-  Eigen::Matrix3d to_unit = Eigen::Matrix3d::Zero();
-  if (within) to_unit = (within_scale * within->axes()).cwiseInverse().asDiagonal() * within->rotation().transpose();
   double x1 = 1e300, y1 = 1e300, x2 = -1e300, y2 = -1e300;
   int n = 0;
   for (size_t i = 0; i < voxels_.size(); ++i) {
     if (!occupied(voxels_[i])) continue;
     const Eigen::Vector3d x_w = centreOf(keys_[i]);
-    if (within && !((to_unit * (x_w - within->center())).squaredNorm() <= 1.0)) continue;
+    if (within && !(within->mahalanobisRadius(x_w) <= within_scale)) continue;
     const Eigen::Vector3d x_c = pose.transform(x_w);
     if (x_c.z() < 1e-3) continue;
     const double u = K.fx * x_c.x() / x_c.z() + K.cx, w = K.fy * x_c.y() / x_c.z() + K.cy;
