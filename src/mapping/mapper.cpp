@@ -533,7 +533,8 @@ void Mapper::mergeDuplicateVoxelTracks(bool every_pair) {
       TrackingOptions same_surface = options_.tracking;
       same_surface.match_radius = std::min(same_surface.match_radius, options_.voxels.voxel_size * 1.01);
       if (!voxelObjectsMatch(a.voxels, b.voxels, same_surface)) continue;
-      a.voxels.absorb(b.voxels);
+      a.voxels.absorb(b.voxels);  // b's integrations now count after a's
+      a.integrations.insert(a.integrations.end(), b.integrations.begin(), b.integrations.end());
       for (const auto& [category, weight] : b.labels) a.labels[category] += weight;
       a.observations += b.observations;
       a.last_seen = std::max(a.last_seen, b.last_seen);

@@ -275,8 +275,11 @@ void VoxelObject::absorb(const VoxelObject& other) {
     Voxel& v = voxels_[indexOrAdd(other.keys_[i], &added)];
     v.log_odds = std::clamp(v.log_odds + theirs.log_odds, l_min, l_max);
     addToMean(v, Eigen::Vector3d(theirs.mean[0], theirs.mean[1], theirs.mean[2]) / kMeanUnits, theirs.points);
-    v.stamp = frames_;  // counts as hit by this object's latest keyframe, not by a future one
+    // The other model's integrations are numbered after this one's, so that each voxel still
+    // moves with the keyframe that placed it (moveWithKeyframes).
+    if (theirs.stamp > 0) v.stamp = frames_ + theirs.stamp;
   }
+  frames_ += other.frames_;
   enforceBudget();
 }
 

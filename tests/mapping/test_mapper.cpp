@@ -889,6 +889,15 @@ TEST(Mapper, ALoopClosureJoinsTwoVoxelModelsOfOneObject) {
   ASSERT_EQ(map.objects.size(), 1u);
   EXPECT_LT((map.objects[0].ellipsoid.center() - box.box_center).norm(), 0.03);
   EXPECT_EQ(mapper.objects()[0].observations, 12);
+  // The joined model keeps the keyframes of each part: a correction of the return's keyframes
+  // alone moves what they saw last (the return retraced the way out: nearly every voxel), where
+  // those voxels counted as the older model's before.
+  const Pose shift(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.1, 0.0, 0.0));
+  for (size_t k = 10; k < poses.size(); ++k) poses[k] = poses[k] * shift;
+  mapper.updateKeyframePoses(poses);
+  ASSERT_EQ(mapper.map().objects.size(), 1u);
+  const Eigen::Vector3d moved = mapper.map().objects[0].ellipsoid.center() - map.objects[0].ellipsoid.center();
+  EXPECT_LT((moved - Eigen::Vector3d(-0.1, 0.0, 0.0)).norm(), 0.01);  // by the correction's inverse shift
 }
 
 // A monocular host's poses in a unit of its own (here 2.5 m: every translation divided by it),

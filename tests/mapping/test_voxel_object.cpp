@@ -248,6 +248,30 @@ TEST(VoxelObject, MovedWithTheirKeyframesEachVoxelFollowsTheKeyframeThatLastHitI
   EXPECT_EQ(still.occupiedPointMeans(0.01), v.occupiedPointMeans(0.01));
 }
 
+// A model absorbed into another keeps its keyframes: its integrations count after the other's,
+// so its voxels move with its own keyframes' corrections, not with the other's latest.
+TEST(VoxelObject, AbsorbedVoxelsMoveWithTheKeyframesThatPlacedThem) {
+  const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
+  const auto surfacePoint = [&](double u, double v_px) {
+    return camera.inverse().transform(Eigen::Vector3d((u - kVoxelCamera.cx) / kVoxelCamera.fx * 2.5,
+                                                      (v_px - kVoxelCamera.cy) / kVoxelCamera.fy * 2.5, 2.5));
+  };
+  VoxelObject older, younger;  // the plane's left part, twice; its right part, once
+  older.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 310, 300));
+  older.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 310, 300));
+  younger.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(330, 200, 390, 300));
+  older.absorb(younger);
+  const Eigen::Vector3d left = surfacePoint(260, 250), right = surfacePoint(380, 250);
+  const Pose first(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 1)),
+      second(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 0, 0)),
+      third(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 1, 0));
+  older.moveWithKeyframes({first, second, third});  // the older model's two keyframes, the younger's one
+  EXPECT_NEAR(older.probabilityAt(second.transform(left)), bayes(0.7, 0.7), 1e-6);
+  EXPECT_NEAR(older.probabilityAt(third.transform(right)), 0.7, 1e-6);
+  EXPECT_EQ(older.probabilityAt(second.transform(right)), 0.5);  // not with the older model's latest
+  EXPECT_EQ(older.probabilityAt(first.transform(left)), 0.5);
+}
+
 TEST(VoxelObject, MissesOutsideTheMaskAndInFreeSpaceButNotWhenHidden) {
   const Pose camera;
   const BinaryMask full = rectMask(300, 220, 340, 260);

@@ -76,7 +76,9 @@ class VoxelObject {
   /// Fuses another model of the same object (same options) into this one: the evidence each
   /// model holds for a voxel adds up (log-odds sum of eq. 1, clamped as in integrate()). Misses
   /// the other model's keyframes would have given this model's own voxels are not known, so
-  /// they are not counted.
+  /// they are not counted. The other model's integrate() calls count after this one's (its k-th
+  /// becomes this one's n + k-th, n this model's count before): a voxel both hold counts as last
+  /// hit by the other's.
   void absorb(const VoxelObject& other);
 
   /// Moves the object rigidly, x -> R x + t (a host's correction of the keyframes that saw it):
@@ -87,8 +89,8 @@ class VoxelObject {
 
   /// Moves each voxel with the keyframe that last hit it, as moveRigidly moves them all:
   /// `motions[k - 1]` (x -> R x + t, a Pose's transform) for the voxels whose last hit came
-  /// from the k-th integrate() (absorbed voxels count as hit by the latest; past the end of
-  /// `motions`, its last). A host that corrects its keyframes by different amounts moves what
+  /// from the k-th integrate() (absorbed models' integrations numbered as absorb() says; past
+  /// the end of `motions`, its last). A host that corrects its keyframes by different amounts moves what
   /// each keyframe placed with that keyframe. No motions: nothing moves.
   void moveWithKeyframes(const std::vector<Pose>& motions);
 
