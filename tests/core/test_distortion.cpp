@@ -62,6 +62,37 @@ TEST(Distortion, UndistortsEveryPixelOfTheImageAsOpenCv) {
   EXPECT_GT((corner - Eigen::Vector2d(-0.5, -0.5)).norm(), 10.0);
 }
 
+// Keypoints of a raw image (a host's ORB keypoints) go where OpenCV undistorts them, keeping
+// their map point; one the model cannot undo is left out and counted.
+TEST(Distortion, KeypointsAreUndistortedAsOpenCvAndTheUndoableCounted) {
+  std::vector<Keypoint> raw;
+  std::vector<cv::Point2d> pixels;
+  for (int i = 0; i < 40; ++i) {
+    const Eigen::Vector2d uv(7.5 + 16.0 * i, 3.0 + 11.5 * i);
+    raw.push_back({100 + i, uv});
+    pixels.emplace_back(uv.x(), uv.y());
+  }
+  raw.insert(raw.begin() + 5, Keypoint{7, Eigen::Vector2d(std::nan(""), 10.0)});
+  std::vector<cv::Point2d> theirs;
+  cv::undistortPoints(pixels, theirs, cameraMatrix(kFr2), coefficients(kFr2Lens), cv::noArray(), cameraMatrix(kFr2),
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 200, 1e-15));
+  size_t left_out = 0;
+  const std::vector<Keypoint> moved = undistortKeypoints(Lens{kFr2, kFr2Lens}, raw, &left_out);
+  EXPECT_EQ(left_out, 1u);
+  ASSERT_EQ(moved.size(), pixels.size());
+  double farthest = 0.0;
+  for (size_t i = 0; i < moved.size(); ++i) {
+    EXPECT_EQ(moved[i].point_index, 100 + static_cast<int>(i));
+    EXPECT_LT((moved[i].uv - Eigen::Vector2d(theirs[i].x, theirs[i].y)).norm(), 1e-4);
+    farthest = std::max(farthest, (moved[i].uv - Eigen::Vector2d(pixels[i].x, pixels[i].y)).norm());
+  }
+  EXPECT_GT(farthest, 5.0);  // they did move
+  // Without a lens's distortion they stay exactly where they were.
+  const std::vector<Keypoint> same = undistortKeypoints(Lens{kFr2, Distortion{}}, moved);
+  ASSERT_EQ(same.size(), moved.size());
+  for (size_t i = 0; i < same.size(); ++i) EXPECT_EQ(same[i].uv, moved[i].uv);
+}
+
 TEST(Distortion, NoDistortionChangesNothing) {
   const Distortion none;
   EXPECT_TRUE(none.isZero());

@@ -266,6 +266,19 @@ TEST(BoxEllipsoidBuilder, StatusesInsteadOfGuesses) {
   const BoxEllipsoidResult r = buildEllipsoidFromBoxes(kK, with_nan);
   EXPECT_TRUE(r.ok()) << r.reason;
   EXPECT_EQ(r.views_used, 5);
+  // A camera that faces away from where the other views' rays meet, its box on its optical
+  // axis, whose line runs back through them: no object behind a camera is fitted.
+  std::vector<BoxView> away = ringViews(truth, 6, 2.0, 90.0);
+  const Eigen::Vector3d eye = away[0].pose.center();
+  const double hw = 0.5 * away[0].box.width(), hh = 0.5 * away[0].box.height();
+  away.push_back({Pose::lookAt(eye, 2.0 * eye - truth.center()), Box(kK.cx - hw, kK.cy - hh, kK.cx + hw, kK.cy + hh)});
+  const BoxEllipsoidResult behind = buildEllipsoidFromBoxes(kK, away);
+  EXPECT_EQ(behind.status, BoxEllipsoidStatus::BehindCamera);
+  EXPECT_EQ(std::string(toString(behind.status)), "behind camera");
+  // Poses of the wrong convention (camera->world read as world->camera) fit nothing either.
+  std::vector<BoxView> inverted = ringViews(truth, 6, 2.0, 90.0);
+  for (BoxView& v : inverted) v.pose = v.pose.inverse();
+  EXPECT_FALSE(buildEllipsoidFromBoxes(kK, inverted).ok());
 }
 
 // Boxes from a 10 degree arc leave the depth of a thin object (a book, 4 x 17 x 24 cm, seen

@@ -110,6 +110,40 @@ TEST(EllipseFit, OutlineDropsTheImageBorderSoTruncatedObjectsFitWell) {
   EXPECT_GT(wasserstein2(*moments, e), 10.0);
 }
 
+// The library's outline, from the runs, is the decoded mask's outline for shapes whose columns
+// have no gaps (an ellipse), wherever the image border cuts them: the same edge midpoints, the
+// border's dropped, and the same verdict on touching the border.
+TEST(EllipseFit, RleOutlineIsTheDecodedOutlineAndDropsEveryBorder) {
+  const int W = 200, H = 150;
+  const Ellipse shapes[] = {
+      Ellipse({100, 75}, {40, 25}, 0.3),   // inside
+      Ellipse({-10, 70}, {50, 30}, 0.2),   // cut by the left border
+      Ellipse({195, 60}, {30, 45}, -0.4),  // the right
+      Ellipse({90, 5}, {60, 20}, 0.1),     // the top
+      Ellipse({120, 148}, {35, 25}, 0.7),  // the bottom
+      Ellipse({190, 140}, {40, 30}, 0.5),  // a corner
+  };
+  int touching = 0;
+  for (const Ellipse& e : shapes) {
+    const BinaryMask m = test::rasterEllipse(e, W, H);
+    bool expected_border = false, border = false;
+    std::vector<Eigen::Vector2d> expected = test::maskOutline(m, &expected_border);
+    std::vector<Eigen::Vector2d> ours = rleOutline(encodeMask(m), &border);
+    const auto byPosition = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+      return a(0) != b(0) ? a(0) < b(0) : a(1) < b(1);
+    };
+    std::sort(expected.begin(), expected.end(), byPosition);
+    std::sort(ours.begin(), ours.end(), byPosition);
+    EXPECT_EQ(ours, expected) << e.center().transpose();
+    EXPECT_EQ(border, expected_border) << e.center().transpose();
+    touching += border;
+    for (const Eigen::Vector2d& p : ours) {
+      EXPECT_TRUE(p(0) > -0.5 && p(0) < W - 0.5 && p(1) > -0.5 && p(1) < H - 0.5) << p.transpose();
+    }
+  }
+  EXPECT_EQ(touching, 5);
+}
+
 TEST(EllipseFit, ProjectivelyInscribedEllipseIsTheImageOfTheRectanglesEllipse) {
   // A planar rectangle seen in perspective: its inscribed ellipse, as a very flat ellipsoid,
   // projects to the ellipse computed from the four projected corners.

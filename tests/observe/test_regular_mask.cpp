@@ -294,6 +294,16 @@ TEST(Observe, PoliciesAndBadInput) {
   const ObserveResult rm = observeDetection(round, W, H, mask);
   EXPECT_EQ(rm.observation->source, EllipseSource::Mask);
   EXPECT_LT(wasserstein2(rm.observation->ellipse, Ellipse({100, 70}, {40, 25}, 0.3)), 1.0);
+  // The other fits a host may choose for masks that are not regular: the mask's moments and the
+  // direct fit of its outline recover the rasterised ellipse as well.
+  for (const MaskFitMethod method : {MaskFitMethod::Moments, MaskFitMethod::Direct}) {
+    ObserveOptions chosen = mask;
+    chosen.irregular_fit = method;
+    const ObserveResult rf = observeDetection(round, W, H, chosen);
+    EXPECT_EQ(rf.observation->source, EllipseSource::Mask);
+    EXPECT_LT(wasserstein2(rf.observation->ellipse, Ellipse({100, 70}, {40, 25}, 0.3)), 1.0);
+    EXPECT_GT(wasserstein2(rf.observation->ellipse, rm.observation->ellipse), 1e-6);  // another fit than the hull's
+  }
   // A polygon stands for a mask under Solid (the default) and Mask, and gives the same observation.
   Detection polygon = d;
   polygon.mask.reset();

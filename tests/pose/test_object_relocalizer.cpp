@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -244,6 +245,24 @@ TEST(ObjectRelocalizer, InvalidOptionsGiveInvalidInputNamingTheField) {
   expectRefused(o, "refinement.polish_loss_scale");
   o.refinement.polish_loss_scale = std::numeric_limits<double>::infinity();
   expectRefused(o, "refinement.polish_loss_scale");
+  // One field of each remaining check, each with the name its message gives.
+  const std::vector<std::pair<std::function<void(RelocalizerOptions&)>, std::string>> others = {
+      {[](RelocalizerOptions& x) { x.search.budget.max_iterations = -1; }, "search.budget iteration counts"},
+      {[](RelocalizerOptions& x) { x.search.budget.success_probability = 1.0; }, "search.budget.success_probability"},
+      {[](RelocalizerOptions& x) { x.scoring.min_category_share = -0.1; }, "scoring.min_category_share"},
+      {[](RelocalizerOptions& x) { x.few_objects.max_pair_hypotheses = -1; }, "few_objects.max_pair_hypotheses"},
+      {[](RelocalizerOptions& x) { x.few_objects.solver.axis_step_deg = 0.0; }, "few_objects.solver"},
+      {[](RelocalizerOptions& x) { x.refinement.refiner.object_loss_scale = 0.0; }, "refinement.refiner"},
+      {[](RelocalizerOptions& x) { x.refinement.refiner.function_tolerance = -1e-9; }, "refinement.refiner"},
+      {[](RelocalizerOptions& x) { x.acceptance.min_evidence = std::nan(""); }, "acceptance.min_evidence"},
+      {[](RelocalizerOptions& x) { x.acceptance.unexplained_penalty = -0.5; }, "acceptance.unexplained_penalty"},
+      {[](RelocalizerOptions& x) { x.acceptance.min_margin = -0.1; }, "acceptance.min_margin"},
+  };
+  for (const auto& [spoil, field] : others) {
+    o = RelocalizerOptions();
+    spoil(o);
+    expectRefused(o, field);
+  }
 }
 
 TEST(ObjectRelocalizer, StatusesInsteadOfCrashes) {

@@ -213,6 +213,38 @@ TEST(TrackRelocalizer, KeepsTheNewestFramesAndTurnsDownBadInput) {
   EXPECT_EQ(unusable.size(), 0);
 }
 
+// The track's evidence is weighed against its length: the same frames that pass at the default
+// per-frame bar are turned down, pose still given, when each frame must explain more than it
+// can.
+TEST(TrackRelocalizer, ATrackThatExplainsTooLittlePerFrameIsLowEvidence) {
+  const ObjectMap map = desksAndAPlant();
+  std::mt19937 rng(8);
+  std::vector<std::pair<std::vector<Observation>, Pose>> frames;
+  std::vector<int> ids;
+  while (frames.size() < 3) {
+    const Pose truth = plantView(rng);
+    std::vector<Observation> observations = observe(map, truth, rng, &ids);
+    if (holds(ids, kPlantId) && observations.size() >= 4) frames.emplace_back(std::move(observations), truth);
+  }
+  const auto lastOfTrack = [&](const ObjectRelocalizer& relocalizer, const TrackOptions& options) {
+    TrackRelocalizer track(relocalizer, options);
+    TrackResult r;
+    for (const auto& [observations, truth] : frames) r = track.add(observations, truth);
+    return r;
+  };
+  const ObjectRelocalizer relocalizer(map, test::testIntrinsics());
+  const TrackResult passed = lastOfTrack(relocalizer, TrackOptions{});
+  ASSERT_EQ(passed.result.status, RelocalizationStatus::Success) << passed.result.reason;
+  ASSERT_EQ(passed.frames, 3);
+  TrackOptions demanding;
+  demanding.min_mean_evidence = passed.track_evidence / 3 + 0.01;
+  const TrackResult weak = lastOfTrack(relocalizer, demanding);
+  EXPECT_EQ(weak.result.status, RelocalizationStatus::LowEvidence);
+  EXPECT_NE(weak.result.reason.find("per frame"), std::string::npos) << weak.result.reason;
+  EXPECT_TRUE(weak.result.pose.rotation().isApprox(passed.result.pose.rotation()));
+  EXPECT_TRUE(weak.result.pose.translation().isApprox(passed.result.pose.translation()));
+}
+
 TEST(TrackRelocalizer, TracksOfRandomBoxesGetNoPose) {
   // Boxes of the map's categories at random places and sizes, frame after frame, along a walk:
   // no evidence of the map, so no pose may be reported.
