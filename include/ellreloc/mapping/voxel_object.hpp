@@ -89,8 +89,8 @@ class VoxelObject {
 
   /// Moves each voxel with the keyframe that last hit it, as moveRigidly moves them all:
   /// `motions[k - 1]` (x -> R x + t, a Pose's transform) for the voxels whose last hit came
-  /// from the k-th integrate() (absorbed models' integrations numbered as absorb() says; past
-  /// the end of `motions`, its last). A host that corrects its keyframes by different amounts moves what
+  /// from the k-th integrate() (an absorbed model's numbered as absorb() says; past the end of
+  /// `motions`, its last). A host that corrects its keyframes by different amounts moves what
   /// each keyframe placed with that keyframe. No motions: nothing moves.
   void moveWithKeyframes(const std::vector<Pose>& motions);
 
