@@ -213,9 +213,8 @@ TEST(TrackRelocalizer, KeepsTheNewestFramesAndTurnsDownBadInput) {
   EXPECT_EQ(unusable.size(), 0);
 }
 
-// The track's evidence is weighed against its length: the same frames that pass at the default
-// per-frame bar are turned down, pose still given, when each frame must explain more than it
-// can.
+// The track's evidence is weighed against its length: frames that pass at the default bar per
+// frame are turned down, pose still given, when each must explain more than it can.
 TEST(TrackRelocalizer, ATrackThatExplainsTooLittlePerFrameIsLowEvidence) {
   const ObjectMap map = desksAndAPlant();
   std::mt19937 rng(8);

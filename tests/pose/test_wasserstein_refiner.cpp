@@ -205,7 +205,7 @@ TEST(WassersteinRefiner, DegenerateInputIsHandled) {
   bad.push_back({Ellipse({std::nan(""), 1}, {1, 1}, 0), s.matches[0].ellipsoid});
   const RefinementResult rb = refinePose(K, s.truth, bad);
   EXPECT_EQ(rb.object_residuals.back(), -1.0);
-  // Invalid intrinsics or a non-rigid initial pose: the pose given comes back, said so.
+  // Invalid intrinsics or a non-finite initial pose: the pose given comes back, said so.
   const RefinementResult no_camera = refinePose(Intrinsics(), s.truth, s.matches);
   EXPECT_TRUE(no_camera.fell_back);
   EXPECT_NE(no_camera.message.find("invalid intrinsics"), std::string::npos) << no_camera.message;
