@@ -30,6 +30,12 @@ BinaryMask rectMask(int x1, int y1, int x2, int y2) {
   return m;
 }
 
+/// The world point that pixel (u, v) of kVoxelCamera at `camera` (world->camera) sees at `depth`.
+Eigen::Vector3d pointOfPixel(const Pose& camera, double u, double v, double depth) {
+  return camera.inverse().transform(Eigen::Vector3d((u - kVoxelCamera.cx) / kVoxelCamera.fx * depth,
+                                                    (v - kVoxelCamera.cy) / kVoxelCamera.fy * depth, depth));
+}
+
 /// Eq. 1 of the paper with prior 0.5: the posterior after an observation with P(n | z) = pz.
 double bayes(double prior, double pz) { return 1.0 / (1.0 + (1.0 - pz) / pz * (1.0 - prior) / prior); }
 
@@ -195,9 +201,7 @@ TEST(VoxelObject, MovedRigidlyTheVoxelsFollowTheirPoints) {
   // The evidence goes with the points: the left part, hit twice, and the right part, hit once
   // and then missed (outside the second mask).
   const auto meanNear = [&](double u, double v_px) {
-    const Eigen::Vector3d x_c((u - kVoxelCamera.cx) / kVoxelCamera.fx * 2.5,
-                              (v_px - kVoxelCamera.cy) / kVoxelCamera.fy * 2.5, 2.5);
-    const Eigen::Vector3d x = camera.inverse().transform(x_c);
+    const Eigen::Vector3d x = pointOfPixel(camera, u, v_px, 2.5);
     return *std::min_element(before.begin(), before.end(), [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
       return (a - x).norm() < (b - x).norm();
     });
@@ -225,11 +229,7 @@ TEST(VoxelObject, MovedWithTheirKeyframesEachVoxelFollowsTheKeyframeThatLastHitI
   const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
   v.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 390, 300));
   v.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 320, 300));
-  const auto surfacePoint = [&](double u, double v_px) {
-    return camera.inverse().transform(Eigen::Vector3d((u - kVoxelCamera.cx) / kVoxelCamera.fx * 2.5,
-                                                      (v_px - kVoxelCamera.cy) / kVoxelCamera.fy * 2.5, 2.5));
-  };
-  const Eigen::Vector3d left = surfacePoint(260, 250), right = surfacePoint(380, 250);
+  const Eigen::Vector3d left = pointOfPixel(camera, 260, 250, 2.5), right = pointOfPixel(camera, 380, 250, 2.5);
   const Pose first(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 1)),
       second(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 0, 0));
   VoxelObject each = v;
@@ -252,16 +252,12 @@ TEST(VoxelObject, MovedWithTheirKeyframesEachVoxelFollowsTheKeyframeThatLastHitI
 // so its voxels move with its own keyframes' corrections, not with the other's latest.
 TEST(VoxelObject, AbsorbedVoxelsMoveWithTheKeyframesThatPlacedThem) {
   const Pose camera = Pose::lookAt(Eigen::Vector3d(0.3, -2.0, 1.2), Eigen::Vector3d(0.3, 0.5, 0.8));
-  const auto surfacePoint = [&](double u, double v_px) {
-    return camera.inverse().transform(Eigen::Vector3d((u - kVoxelCamera.cx) / kVoxelCamera.fx * 2.5,
-                                                      (v_px - kVoxelCamera.cy) / kVoxelCamera.fy * 2.5, 2.5));
-  };
   VoxelObject older, younger;  // the plane's left part, twice; its right part, once
   older.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 310, 300));
   older.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(250, 200, 310, 300));
   younger.integrate(kVoxelCamera, camera, flatDepth(2.5f), rectMask(330, 200, 390, 300));
   older.absorb(younger);
-  const Eigen::Vector3d left = surfacePoint(260, 250), right = surfacePoint(380, 250);
+  const Eigen::Vector3d left = pointOfPixel(camera, 260, 250, 2.5), right = pointOfPixel(camera, 380, 250, 2.5);
   const Pose first(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 1)),
       second(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 0, 0)),
       third(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 1, 0));
