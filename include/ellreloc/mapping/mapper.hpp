@@ -137,12 +137,11 @@ class Mapper {
   /// mode: every object is fitted again to its boxes, each seen from its keyframe's new pose (as
   /// finish() does, so the map is what these poses would have made of the same associations).
   /// Voxel mode: the depth images are gone, so each voxel moves with the keyframe that last hit
-  /// it (it goes where that keyframe's camera now puts it); the up estimated
-  /// from the floor is measured again from each keyframe's floor at its new pose. Objects that
-  /// now coincide are joined as while mapping (two tracks of one object that a drift split before
-  /// a loop closed). The camera envelope follows the new poses. Throws ellreloc::Error naming the
-  /// problem (the map then unchanged) when the count differs from the keyframes added or a pose
-  /// is not finite.
+  /// it (it goes where that keyframe's camera now puts it); the up estimated from the floor is
+  /// measured again from each keyframe's floor at its new pose. Objects that now coincide are
+  /// joined as while mapping (two tracks of one object that a drift split before a loop closed).
+  /// The camera envelope follows the new poses. Throws ellreloc::Error naming the problem (the
+  /// map then unchanged) when the count differs from the keyframes added or a pose is not finite.
   void updateKeyframePoses(const std::vector<Pose>& poses);
 
   /// Boxes mode: the world's unit in metres that the objects tell, for poses of unknown scale
