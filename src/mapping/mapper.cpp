@@ -421,35 +421,7 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     masks.push_back(std::move(*mask));
   }
 
-  // 2D tracking against the objects seen in the last keyframes, by their projected voxels, of
-  // each detection with a mask only to objects whose depth range holds the mask's median depth.
-  std::vector<std::pair<size_t, std::vector<Box>>> expected;
-  std::vector<std::pair<double, double>> depth_ranges;
-  for (size_t i = 0; i < tracks_.size(); ++i) {
-    const Track& t = tracks_[i];
-    if (keyframes_ - t.last_seen > options_.track_window) continue;
-    // An object in the map projects only its voxels near its ellipsoid: a voxel model holds a few
-    // strays (mask pixels of a neighbour at the same depth), and a box that reaches them can draw
-    // the neighbour's detection to the object once the object itself has left the view.
-    if (const auto box = t.voxels.projectedBox(K_, pose, 10, t.built ? &t.built->object.ellipsoid : nullptr)) {
-      expected.emplace_back(i, std::vector<Box>{*box});
-      depth_ranges.push_back(depthRange(t.voxels, pose));
-    }
-  }
-  PairGate gate = PairGate::Constant(static_cast<long>(expected.size()), static_cast<long>(used.size()), true);
-  const double margin = options_.tracking.depth_margin;
-  for (size_t k = 0; k < used.size(); ++k) {
-    if (!detections[used[k]].mask) continue;  // a box as the mask holds the background too
-    // Every positive finite reading: the median only places the detection in depth.
-    const std::vector<double> readings =
-        maskDepths(depth, masks[k], 1, std::numeric_limits<double>::denorm_min(), std::numeric_limits<double>::max());
-    if (readings.empty()) continue;
-    const double z = median(readings);
-    for (size_t i = 0; i < expected.size(); ++i)
-      gate(static_cast<long>(i), static_cast<long>(k)) =
-          z >= depth_ranges[i].first - margin && z <= depth_ranges[i].second + margin;
-  }
-  const std::vector<int> tracked = associate2D(expected, detections, used, gate);
+  const std::vector<int> tracked = trackVoxelDetections2D(pose, detections, used, masks, depth);
   // An object 2D tracking paired with a detection is that detection's in this keyframe: a
   // detector gives one box per object, so no other detection may join it by 3D matching (the
   // detections are taken one at a time, and an earlier one would otherwise find it still free).
@@ -503,6 +475,38 @@ void Mapper::addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& de
     report->object_ids[used[k]] = tracks_.back().id;
   }
   mergeDuplicateVoxelTracks();
+}
+
+std::vector<int> Mapper::trackVoxelDetections2D(const Pose& pose, const std::vector<Detection>& detections,
+                                                const std::vector<size_t>& used, const std::vector<BinaryMask>& masks,
+                                                const DepthImage& depth) const {
+  std::vector<std::pair<size_t, std::vector<Box>>> expected;
+  std::vector<std::pair<double, double>> depth_ranges;
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& t = tracks_[i];
+    if (keyframes_ - t.last_seen > options_.track_window) continue;
+    // An object in the map projects only its voxels near its ellipsoid: a voxel model holds a few
+    // strays (mask pixels of a neighbour at the same depth), and a box that reaches them can draw
+    // the neighbour's detection to the object once the object itself has left the view.
+    if (const auto box = t.voxels.projectedBox(K_, pose, 10, t.built ? &t.built->object.ellipsoid : nullptr)) {
+      expected.emplace_back(i, std::vector<Box>{*box});
+      depth_ranges.push_back(depthRange(t.voxels, pose));
+    }
+  }
+  PairGate gate = PairGate::Constant(static_cast<long>(expected.size()), static_cast<long>(used.size()), true);
+  const double margin = options_.tracking.depth_margin;
+  for (size_t k = 0; k < used.size(); ++k) {
+    if (!detections[used[k]].mask) continue;  // a box as the mask holds the background too
+    // Every positive finite reading: the median only places the detection in depth.
+    const std::vector<double> readings =
+        maskDepths(depth, masks[k], 1, std::numeric_limits<double>::denorm_min(), std::numeric_limits<double>::max());
+    if (readings.empty()) continue;
+    const double z = median(readings);
+    for (size_t i = 0; i < expected.size(); ++i)
+      gate(static_cast<long>(i), static_cast<long>(k)) =
+          z >= depth_ranges[i].first - margin && z <= depth_ranges[i].second + margin;
+  }
+  return associate2D(expected, detections, used, gate);
 }
 
 void Mapper::mergeDuplicateVoxelTracks(bool every_pair) {

@@ -25,6 +25,7 @@
 #include "ellreloc/core/depth_image.hpp"
 #include "ellreloc/core/detection.hpp"
 #include "ellreloc/core/distortion.hpp"
+#include "ellreloc/core/mask.hpp"
 #include "ellreloc/core/object_map.hpp"
 #include "ellreloc/mapping/association.hpp"
 #include "ellreloc/mapping/box_ellipsoid_builder.hpp"
@@ -186,6 +187,12 @@ class Mapper {
   void checkKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage* depth) const;
   void addVoxelKeyframe(const Pose& pose, const std::vector<Detection>& detections, const DepthImage& depth,
                         KeyframeReport* report);
+  /// Voxel mode's 2D tracking of the used detections (with their masks) against the objects seen
+  /// in the last keyframes, by their projected voxels; a detection with a mask goes only to
+  /// objects whose depth range holds the mask's median depth. Each one's track index, or -1.
+  std::vector<int> trackVoxelDetections2D(const Pose& pose, const std::vector<Detection>& detections,
+                                          const std::vector<size_t>& used, const std::vector<BinaryMask>& masks,
+                                          const DepthImage& depth) const;
   /// 2D association (association.hpp) of the used detections with tracks' expected boxes
   /// (track index, its possible boxes, at least one): each used detection's track index, or -1.
   /// `gate` (expected x used) rules pairs out; empty: none.
