@@ -9,7 +9,7 @@ packages=(
   libopengv-dev  # benchmarks only: P3P comparison with OpenGV's Kneip solver
   clang-14 libclang-rt-14-dev  # reliability only: sanitizer builds and libFuzzer (scripts/sanitize.sh, fuzz.sh)
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python bindings (python/) and their tests
-  linux-perf  # profiling only: `perf record` (docs/benchmarks.md, "Real frames")
+  linux-perf  # profiling only: `perf record` (docs/benchmarks.md, "Start-up": the profiles' commands)
   chromium  # tests only: renders `ellreloc report` pages headless (skipped without it)
 )
 
