@@ -187,7 +187,10 @@ ObjectMap readMap(const std::string& path, std::vector<std::string>* warnings) {
   const std::string text = readTextFile(path);
   const size_t first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) throw Error(path + ": empty file, expected a map");
-  return text[first] == '{' ? parseMapJson(text, path, warnings) : parseOaSlamMap(text, path, warnings);
+  // An OA-SLAM text map starts with a number: any JSON (a detections file given by mistake, too)
+  // goes to the JSON reader, which says what it expected.
+  const bool json = text[first] == '{' || text[first] == '[';
+  return json ? parseMapJson(text, path, warnings) : parseOaSlamMap(text, path, warnings);
 }
 
 void writeMap(const std::string& path, const ObjectMap& map) {

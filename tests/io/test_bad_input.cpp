@@ -110,6 +110,20 @@ TEST(BadInput, ValuesOutOfRangeNameTheField) {
   }
 }
 
+// A JSON file that is not a map (a detections file given by mistake) is read as JSON and said
+// to be the wrong JSON, not parsed as an OA-SLAM text map line by line.
+TEST(BadInput, AJsonArrayGivenAsAMapIsNamedAsTheWrongJson) {
+  test::TempDir dir;
+  const std::string path = dir.path("detections_as_map.json");
+  io::writeFileAtomically(path, "[{\"file_name\": \"a.png\", \"detections\": []}]");
+  try {
+    io::readMap(path);
+    ADD_FAILURE() << "a detections file was read as a map";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("expected a JSON object with \"objects\""), std::string::npos) << e.what();
+  }
+}
+
 TEST(BadInput, FailedWritesLeaveNoFile) {
   test::TempDir dir;
   ObjectMap bad;

@@ -10,7 +10,7 @@
 
 namespace ellreloc::io {
 
-/// Reads a map file: JSON when the first non-blank character is '{', otherwise OA-SLAM's text
+/// Reads a map file: JSON when the first non-blank character is '{' or '[', otherwise OA-SLAM's text
 /// format. Rotations within 1e-3 of orthonormal (rounded files) are projected onto the nearest
 /// rotation. Throws ellreloc::Error naming the file and the field or line on malformed input.
 /// A well-formed object that cannot be used (mapObjectProblem: a zero, negative, non-finite,
