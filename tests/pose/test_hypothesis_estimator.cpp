@@ -183,3 +183,44 @@ TEST(HypothesisEstimator, ASampledSearchKeepsTheUncorrectedPoseWhenItFitsItsSamp
   EXPECT_GE(closer, samples / 10);
   EXPECT_GE(uncorrected, closer);
 }
+
+// A triplet's poses do not depend on the order of its three pairs: P3P finds the same roots in
+// any order, and each root's centre correction keeps the corrected root nearest that root (not
+// the nearest to whichever root it looked at before). Every triplet of candidate pairs of scenes
+// with 3 px of centre noise, in its three rotations.
+TEST(HypothesisEstimator, ATripletGivesTheSamePosesInAnyOrder) {
+  std::mt19937 rng(29);
+  const Intrinsics K = test::testIntrinsics();
+  int samples = 0;
+  for (int scene = 0; scene < 3; ++scene) {
+    test::ObservedScene s = test::randomObservedScene(12, 3, 1.0, 3.0, K, rng);
+    while (s.observations.size() < 5) s = test::randomObservedScene(12, 3, 1.0, 3.0, K, rng);
+    const RelocalizerOptions options;
+    std::vector<std::pair<int, std::string>> skipped;
+    const pipeline::Candidates candidates =
+        pipeline::collectCandidates(s.observations, s.map, options.scoring, 100000, &skipped);
+    pipeline::PoseScorer scorer(s.observations, candidates, s.map, K, options.scoring);
+    const pipeline::HypothesisEstimator estimator(s.observations, candidates, s.map, K, options, {}, scorer);
+    const int n = static_cast<int>(candidates.pairs.size());
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b)
+        for (int c = b + 1; c < n; ++c) {
+          const int orders[3][3] = {{a, b, c}, {b, c, a}, {c, a, b}};
+          pipeline::PoseHypothesis poses[3][4];
+          int counts[3];
+          for (int k = 0; k < 3; ++k) counts[k] = estimator.generate(orders[k], poses[k]);
+          if (counts[0] == 0 && counts[1] == 0 && counts[2] == 0) continue;
+          ++samples;
+          for (int k = 1; k < 3; ++k) {
+            ASSERT_EQ(counts[k], counts[0]) << "triplet " << a << " " << b << " " << c;
+            for (int i = 0; i < counts[0]; ++i) {  // each pose of the first order among the others
+              double nearest = std::numeric_limits<double>::infinity();
+              for (int j = 0; j < counts[k]; ++j)
+                nearest = std::min(nearest, positionError(poses[k][j].pose, poses[0][i].pose));
+              EXPECT_LT(nearest, 1e-9);
+            }
+          }
+        }
+  }
+  EXPECT_GE(samples, 1000);
+}

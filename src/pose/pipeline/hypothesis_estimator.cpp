@@ -141,11 +141,12 @@ bool HypothesisEstimator::correctCentres(const int* s, Pose* pose) const {
   }
   std::array<Pose, 4> poses;
   const int n = p3p(bearings, centres, &poses);
-  // The nearest root: a radian of turn weighs as a metre of shift.
+  // The root nearest the uncorrected pose: a radian of turn weighs as a metre of shift.
+  const Pose uncorrected = *pose;
   double best = 1e9;
   for (int i = 0; i < n; ++i) {
-    const double d = rotationErrorDeg(poses[i].rotation(), pose->rotation()) * M_PI / 180.0 +
-                     (poses[i].center() - pose->center()).norm() * map_.unit_metres;
+    const double d = rotationErrorDeg(poses[i].rotation(), uncorrected.rotation()) * M_PI / 180.0 +
+                     (poses[i].center() - uncorrected.center()).norm() * map_.unit_metres;
     if (d < best) best = d, *pose = poses[i];
   }
   return n > 0;
