@@ -686,6 +686,7 @@ class SearchBudget:
     max_time_ms: float
     success_probability: float
     enough_extension: float
+    skip_repeated_samples: bool
     seed: int
 
 

@@ -184,6 +184,8 @@ void bindOptionGroups(py::module_& m) {
       .def_readwrite("enough_extension", &RansacOptions::enough_extension,
                      "after a pose explaining every observation (search.stop_when_explained): this many times the "
                      "samples drawn so far, then stop")
+      .def_readwrite("skip_repeated_samples", &RansacOptions::skip_repeated_samples,
+                     "a triplet drawn before counts as drawn but is not solved and scored again")
       .def_readwrite("seed", &RansacOptions::seed);
   py::class_<SearchOptions>(m, "SearchOptions")
       .def(py::init<>())

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <set>
 
 #include "ellreloc/core/p3p.hpp"
@@ -218,6 +219,7 @@ RansacStats referenceRansac(const PnPEstimator& est, Sampler& sampler, const Ran
   int needed = o.max_iterations, enough_stop = std::numeric_limits<int>::max();
   int sample[3];
   Pose models[4];
+  std::set<std::set<int>> drawn;
   while (true) {
     if (st.iterations >= o.max_iterations || st.hypotheses >= o.max_hypotheses) {
       st.budget_exhausted = true;
@@ -229,7 +231,9 @@ RansacStats referenceRansac(const PnPEstimator& est, Sampler& sampler, const Ran
       break;
     }
     ++st.iterations;
-    const int m = est.generate(sample, models);
+    const bool repeated = o.skip_repeated_samples && !drawn.insert({sample[0], sample[1], sample[2]}).second;
+    st.repeated_samples += repeated;
+    const int m = repeated ? 0 : est.generate(sample, models);
     for (int i = 0; i < m; ++i) {
       ++st.hypotheses;
       int inliers = 0;
@@ -254,10 +258,11 @@ RansacStats referenceRansac(const PnPEstimator& est, Sampler& sampler, const Ran
 TEST(Ransac, OnThreadsIsTheSerialLoopThreadSafe) {
   const PnPProblem p = makeProblem(40, 0.6, 1e-3, 11);
   const PnPEstimator est{&p};
-  RansacOptions budgets[4];
+  RansacOptions budgets[5];
   budgets[1].max_hypotheses = 37;
   budgets[2].min_iterations = 300, budgets[2].max_iterations = 301;
   budgets[3].min_iterations = 1, budgets[3].enough_inliers = 10, budgets[3].enough_score = INFINITY;
+  budgets[4].min_iterations = 2000, budgets[4].skip_repeated_samples = true;
   for (const RansacOptions& o : budgets)
     for (int kind = 0; kind < 3; ++kind) {
       Pose expected;
@@ -290,10 +295,59 @@ TEST(Ransac, OnThreadsIsTheSerialLoopThreadSafe) {
         EXPECT_EQ(st.score, ref.score);
         EXPECT_EQ(st.budget_exhausted, ref.budget_exhausted);
         EXPECT_EQ(st.sampler_exhausted, ref.sampler_exhausted);
+        EXPECT_EQ(st.repeated_samples, ref.repeated_samples);
         EXPECT_EQ(seen, expected_seen);
         EXPECT_EQ(best.translation(), expected.translation());
       }
     }
+}
+
+namespace {
+
+/// The PnP estimator that also records the samples it is asked to generate from.
+struct RecordingEstimator : PnPEstimator {
+  mutable std::vector<std::set<int>> generated;
+  int generate(const int* s, Model* models) const {
+    generated.push_back({s[0], s[1], s[2]});
+    return PnPEstimator::generate(s, models);
+  }
+};
+
+}  // namespace
+
+// Six data give 20 triples: 400 random samples repeat most of them, in any order. Skipped, a
+// repeat still counts as drawn (the same count, so the same stopping point) but generates
+// nothing; each triple drawn is generated once, and the best model is the one found without
+// skipping.
+TEST(Ransac, RepeatedSamplesAreCountedButNotGeneratedAgain) {
+  const PnPProblem p = makeProblem(6, 0.0, 1e-4, 13);
+  RansacOptions o;
+  o.min_iterations = 400, o.max_iterations = 400;
+  for (const bool prosac : {false, true}) {
+    SCOPED_TRACE(prosac ? "prosac" : "uniform");
+    RecordingEstimator plain{{&p}}, skipping{{&p}};
+    Pose best_plain, best_skipping;
+    RansacStats plain_stats, skipping_stats;
+    o.skip_repeated_samples = false;
+    UniformSampler u1(6, 3, 3), u2(6, 3, 3);
+    ProsacSampler p1(6, 3, 3, 100), p2(6, 3, 3, 100);
+    prosac ? ransac(plain, p1, o, &best_plain, &plain_stats) : ransac(plain, u1, o, &best_plain, &plain_stats);
+    o.skip_repeated_samples = true;
+    prosac ? ransac(skipping, p2, o, &best_skipping, &skipping_stats)
+           : ransac(skipping, u2, o, &best_skipping, &skipping_stats);
+    EXPECT_EQ(plain_stats.iterations, 400);
+    EXPECT_EQ(skipping_stats.iterations, 400);
+    EXPECT_EQ(plain_stats.repeated_samples, 0);
+    ASSERT_EQ(plain.generated.size(), 400u);
+    // What the plain run drew, each triple once, in the order first drawn.
+    std::vector<std::set<int>> distinct;
+    for (const std::set<int>& t : plain.generated)
+      if (std::find(distinct.begin(), distinct.end(), t) == distinct.end()) distinct.push_back(t);
+    EXPECT_EQ(skipping.generated, distinct);
+    EXPECT_EQ(skipping_stats.repeated_samples, 400 - static_cast<int>(distinct.size()));
+    EXPECT_NEAR(skipping_stats.score, plain_stats.score, 1e-12);
+    EXPECT_LT(rotationErrorOf(best_skipping, p.truth), 0.1);
+  }
 }
 
 // A best model with the support asked for ends the search after enough_extension times as many

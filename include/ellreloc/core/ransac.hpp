@@ -17,6 +17,7 @@
 /// A sample the estimator cannot use (e.g. repeated observations) simply generates 0 models.
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -47,6 +48,12 @@ struct RansacOptions {
   int enough_inliers = std::numeric_limits<int>::max();
   double enough_score = -std::numeric_limits<double>::infinity();
   double enough_extension = 1.0;
+  /// A sample drawn before (the same indices in any order) still counts as drawn, so the stopping
+  /// rules read the same count, but its models are not generated and scored again. Random
+  /// samplers repeat samples, most where there are few to draw from (PROSAC's first prefixes, a
+  /// frame of four observations). Off by default: an estimator whose models depend on the order
+  /// of the sample's indices would lose the other orders.
+  bool skip_repeated_samples = false;
 };
 
 struct RansacStats {
@@ -58,6 +65,7 @@ struct RansacStats {
   double elapsed_ms = 0.0;
   bool budget_exhausted = false;   ///< stopped by max_iterations, max_hypotheses or max_time_ms
   bool sampler_exhausted = false;  ///< an exhaustive sampler enumerated everything
+  int repeated_samples = 0;        ///< drawn before and skipped (skip_repeated_samples)
 };
 
 /// Draws k distinct indices of [0, n) uniformly.
@@ -178,6 +186,56 @@ struct IgnoreScoredModels {
 
 namespace detail {
 
+/// The samples drawn so far, each as its sorted indices (skip_repeated_samples): an
+/// open-addressing table, so that remembering a sample costs a few operations and no allocation
+/// (a search draws thousands, most of which it drops at once).
+template <int K>
+class DrawnSamples {
+ public:
+  /// True when `sample` (in any order) was not drawn before; remembers it.
+  bool insert(const int* sample) {
+    Key key;
+    for (int i = 0; i < K; ++i) {  // insertion sort: K is a minimal sample's size, a handful
+      int j = i;
+      for (; j > 0 && key[j - 1] > sample[i]; --j) key[j] = key[j - 1];
+      key[j] = sample[i];
+    }
+    if (2 * (size_ + 1) > slots_.size()) grow();
+    if (!place(key, &slots_)) return false;
+    ++size_;
+    return true;
+  }
+
+ private:
+  using Key = std::array<int, K>;
+  static constexpr int kEmpty = -1;  // sample indices are never negative
+
+  static uint64_t hash(const Key& key) {
+    uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (int i : key) h = (h ^ static_cast<uint32_t>(i)) * 0xff51afd7ed558ccdull;
+    return h ^ (h >> 29);
+  }
+  /// Puts `key` in `table` (a power of two long) unless it is there; false when it was.
+  static bool place(const Key& key, std::vector<Key>* table) {
+    const size_t mask = table->size() - 1;
+    for (size_t i = hash(key) & mask;; i = (i + 1) & mask) {
+      Key& slot = (*table)[i];
+      if (slot[0] == kEmpty) return slot = key, true;
+      if (slot == key) return false;
+    }
+  }
+  void grow() {
+    Key empty;
+    empty.fill(kEmpty);
+    std::vector<Key> larger(std::max<size_t>(1024, 2 * slots_.size()), empty);
+    for (const Key& key : slots_)
+      if (key[0] != kEmpty) place(key, &larger);
+    slots_.swap(larger);
+  }
+  std::vector<Key> slots_;
+  size_t size_ = 0;
+};
+
 /// Runs a function on `threads` threads (the calling one among them) once per call of run(),
 /// and waits for all of them: a small pool for one RANSAC call's batches. A batch takes tens of
 /// microseconds, about what waking a sleeping thread costs, so the threads spin briefly on an
@@ -255,6 +313,7 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
     double scores[Estimator::kMaxModels];
     int inliers[Estimator::kMaxModels];
     int count = 0;
+    bool repeated = false;  // drawn before: generates nothing
   };
   const auto start = Clock::now();
   const int threads = std::max(1, static_cast<int>(estimators.size()));
@@ -269,13 +328,14 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
     const Estimator& estimator = *estimators[static_cast<size_t>(t)];
     for (int i = next_slot++; i < filled; i = next_slot++) {
       Slot& s = batch[static_cast<size_t>(i)];
-      s.count = estimator.generate(s.sample, s.models);
+      s.count = s.repeated ? 0 : estimator.generate(s.sample, s.models);
       for (int m = 0; m < s.count; ++m) s.scores[m] = estimator.score(s.models[m], &s.inliers[m]);
     }
   };
   std::optional<detail::BatchWorkers> workers;
   if (threads > 1) workers.emplace(threads, work);
   RansacStats st;
+  detail::DrawnSamples<Estimator::kSampleSize> drawn;
   const size_t n = estimators.front()->numData();
   int needed = options.max_iterations;
   int enough_stop = std::numeric_limits<int>::max();  // set once, by the first good enough best model
@@ -296,11 +356,16 @@ bool ransacOnThreads(const std::vector<const Estimator*>& estimators, Sampler& s
       const long room = std::min<long>({options.max_iterations - st.iterations, stop_at - st.iterations,
                                         options.max_hypotheses - st.hypotheses, batch_capacity});
       filled = cursor = 0;
-      while (!sampler_done && filled < room)
-        if (sampler.next(batch[static_cast<size_t>(filled)].sample))
+      while (!sampler_done && filled < room) {
+        Slot& slot = batch[static_cast<size_t>(filled)];
+        if (sampler.next(slot.sample)) {
+          slot.repeated = options.skip_repeated_samples && !drawn.insert(slot.sample);
+          st.repeated_samples += slot.repeated;
           ++filled;
-        else
+        } else {
           sampler_done = true;
+        }
+      }
       if (filled == 0) {
         st.sampler_exhausted = true;
         break;

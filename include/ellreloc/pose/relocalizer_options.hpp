@@ -88,6 +88,7 @@ struct SearchOptions {
     budget.max_hypotheses = 50000;
     budget.max_time_ms = 0.0;  // a time budget makes results depend on the machine: off by default
     budget.success_probability = 0.999;
+    budget.skip_repeated_samples = true;  // P3P gives the same poses in any order of the pairs, to rounding
   }
 };
 

@@ -45,6 +45,7 @@ void searchTriplets(const std::vector<const HypothesisEstimator*>& estimators, c
   if (sampler == HypothesisSampler::Exhaustive) {  // try everything: only hypotheses and time bound it
     budget.min_iterations = std::numeric_limits<int>::max() / 2;
     budget.max_iterations = std::numeric_limits<int>::max() / 2;
+    budget.skip_repeated_samples = false;  // an enumeration repeats nothing
   }
   // In sample order on this thread, where the pool is current: a loose hypothesis that explains
   // every observation is refined first (estimators.front()'s scorer is idle meanwhile).
