@@ -44,8 +44,8 @@ struct SearchOptions {
   /// size, as the refiner weighs a match) or fails the sample check where it passes: the
   /// correction now and then carries a pose to another P3P root, and a triplet drawn by chance
   /// may not be drawn again. An enumeration tries every triplet and keeps the corrected pose.
-  /// Off by default: on real frames it finds a few more poses for about a sixth more time
-  /// (docs/pose.md, options).
+  /// Off by default: on real frames it found a few more poses for about a sixth more time,
+  /// measured while the correction still jumped to far roots often (docs/pose.md, options).
   bool uncorrected_when_closer = false;
   /// Drop a pose when one of its own three pairs overlaps less than scoring.min_overlap: a
   /// wrong triplet rarely fits the three shapes, and this costs three overlaps, not a map.
