@@ -22,11 +22,11 @@ using ellreloc::test::positionError;
 
 namespace {
 
-/// 12 objects of three categories within a metre of the origin, seen exactly from a random pose
-/// that sees at least five of them.
-test::ObservedScene randomEstimatorScene(const Intrinsics& K, std::mt19937& rng) {
-  test::ObservedScene s = test::randomObservedScene(12, 3, 1.0, 0.0, K, rng);
-  while (s.observations.size() < 5) s = test::randomObservedScene(12, 3, 1.0, 0.0, K, rng);
+/// 12 objects of three categories within a metre of the origin, seen from a random pose that
+/// sees at least five of them, their observed centres moved by `centre_noise_px` (0: exactly).
+test::ObservedScene randomEstimatorScene(const Intrinsics& K, std::mt19937& rng, double centre_noise_px = 0.0) {
+  test::ObservedScene s = test::randomObservedScene(12, 3, 1.0, centre_noise_px, K, rng);
+  while (s.observations.size() < 5) s = test::randomObservedScene(12, 3, 1.0, centre_noise_px, K, rng);
   return s;
 }
 
@@ -112,8 +112,7 @@ TEST(HypothesisEstimator, ASampledSearchKeepsTheUncorrectedPoseWhenItFitsItsSamp
   const Intrinsics K = test::testIntrinsics();
   int samples = 0, closer = 0, uncorrected = 0;
   for (int scene = 0; scene < 4; ++scene) {
-    test::ObservedScene s = test::randomObservedScene(12, 3, 1.0, 3.0, K, rng);
-    while (s.observations.size() < 5) s = test::randomObservedScene(12, 3, 1.0, 3.0, K, rng);
+    const test::ObservedScene s = randomEstimatorScene(K, rng, 3.0);
     RelocalizerOptions sampled, corrected, enumerated;
     sampled.search.sampler = corrected.search.sampler = HypothesisSampler::Prosac;
     sampled.search.uncorrected_when_closer = true;
@@ -193,8 +192,7 @@ TEST(HypothesisEstimator, ATripletGivesTheSamePosesInAnyOrder) {
   const Intrinsics K = test::testIntrinsics();
   int samples = 0;
   for (int scene = 0; scene < 3; ++scene) {
-    test::ObservedScene s = test::randomObservedScene(12, 3, 1.0, 3.0, K, rng);
-    while (s.observations.size() < 5) s = test::randomObservedScene(12, 3, 1.0, 3.0, K, rng);
+    const test::ObservedScene s = randomEstimatorScene(K, rng, 3.0);
     const RelocalizerOptions options;
     std::vector<std::pair<int, std::string>> skipped;
     const pipeline::Candidates candidates =
